@@ -1,0 +1,15 @@
+// The `lipsync` tool's subcommands. Each registers itself on the app and runs from a callback;
+// errors are thrown (InputError: bad input, exit 1) and reported by main.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace lipsyncd::cli {
+
+void addSayCommand(CLI::App& app);
+void addAnalyzeCommand(CLI::App& app);
+void addEvalCommand(CLI::App& app);
+void addTrainCommand(CLI::App& app);
+void addCalibrateCommand(CLI::App& app);
+
+}  // namespace lipsyncd::cli

@@ -1,0 +1,143 @@
+// lipsyncd core: the data every stage passes on.
+//
+//   PhonemeSet      the classes a schedule speaks in (the Common Phoneme Set of paper 000,
+//                   table 1, plus silence), with the coarse visual group of each class.
+//   PhonemeMap      how another alphabet (ARPAbet, espeak-ng mnemonics, IPA, pinyin) maps onto
+//                   the set.
+//   PhonemeSchedule timed segments (start, end, phoneme, confidence): the output of the front
+//                   end and the input of the runtime; read and written as TSV (DESIGN.md).
+//   InputError      what every loader throws: a message that names the file, line and field.
+//
+// All of these are plain values, loaded from files under config/ and validated on load.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+namespace lipsyncd {
+
+// An error in something the user gave us (a file, an option, a request). The message reads
+// "FILE:LINE: what is wrong" (line omitted where there is none) so editors can jump to it.
+class InputError : public std::runtime_error {
+public:
+    InputError(const std::string& file, std::size_t line, const std::string& what);
+    explicit InputError(const std::string& what) : std::runtime_error(what) {}
+};
+
+// Where shipped data lives: $LIPSYNCD_DATA_DIR if set, the installed share/lipsyncd when the
+// running binary is installed, else the source tree's config/ (so a fresh build just works).
+std::filesystem::path dataDirectory();
+// `name` as given if it exists, else resolved against dataDirectory().
+std::filesystem::path findDataFile(const std::filesystem::path& name);
+
+// ---------------------------------------------------------------------------------------------
+// Phoneme classes.
+
+struct PhonemeClass {
+    std::string name;      // "aa", "bmp", "sil", ...
+    std::string group;     // coarse visual group: silence, open, mid, rounded, closed, ...
+    std::string examples;  // words that show it, for people reading a report
+    bool vowel = false;
+};
+
+class PhonemeSet {
+public:
+    static PhonemeSet load(const std::filesystem::path& file);
+    // The shipped Common Phoneme Set (config/phonemes/common.toml).
+    static const PhonemeSet& common();
+
+    std::size_t size() const { return classes_.size(); }
+    const PhonemeClass& operator[](std::size_t i) const { return classes_[i]; }
+    std::span<const PhonemeClass> classes() const { return classes_; }
+    std::optional<std::size_t> find(std::string_view name) const;
+    // Index of the silence class ("sil"); every set has one.
+    std::size_t silence() const { return silence_; }
+    // The visual groups in first-seen order, for reports.
+    std::vector<std::string> groups() const;
+
+    explicit PhonemeSet(std::vector<PhonemeClass> classes);  // validates; throws InputError
+
+private:
+    std::vector<PhonemeClass> classes_;
+    std::unordered_map<std::string, std::size_t> index_;
+    std::size_t silence_ = 0;
+};
+
+// Maps symbols of one alphabet onto class names of a PhonemeSet.
+class PhonemeMap {
+public:
+    struct Result {
+        std::string phoneme;  // a class name of the set
+        bool approximate;     // from the map's [nearest] table: the caller should warn
+    };
+    static PhonemeMap load(const std::filesystem::path& file);
+    // Loads config/phonemes/<name>.toml (or a path).
+    static PhonemeMap named(std::string_view nameOrPath);
+
+    // nullopt for a symbol the map does not know (callers warn, naming it).
+    std::optional<Result> map(std::string_view symbol) const;
+    // Marks that are not sounds at all (stress, syllable breaks): callers skip them silently.
+    bool isIgnored(std::string_view symbol) const;
+    const std::string& name() const { return name_; }
+
+private:
+    std::string normalise(std::string_view symbol) const;
+    std::string name_;
+    bool caseSensitive_ = true;
+    bool stripStressDigits_ = false;
+    std::unordered_map<std::string, std::string> exact_;
+    std::unordered_map<std::string, std::string> nearest_;
+    std::vector<std::string> ignored_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Schedules.
+
+struct PhonemeSegment {
+    double start = 0;  // seconds
+    double end = 0;    // seconds
+    std::string phoneme;
+    float confidence = 1.0f;  // in [0, 1]; 1 for labels and TTS
+
+    double duration() const { return end - start; }
+    bool operator==(const PhonemeSegment&) const = default;
+};
+
+using PhonemeSchedule = std::vector<PhonemeSegment>;
+
+struct ScheduleReadOptions {
+    // Translate symbols through this map (e.g. ARPAbet labels); nullptr: names must already be
+    // classes of `set`, though a map can still be guessed per symbol (see readSchedule).
+    const PhonemeMap* map = nullptr;
+    const PhonemeSet* set = nullptr;  // nullptr: PhonemeSet::common()
+    // Gaps between segments become silence (labels often omit pauses); otherwise an error.
+    bool fillGapsWithSilence = true;
+    // Symbols nobody knows: warn (naming symbol and line) and treat as silence, or fail.
+    bool unknownIsError = false;
+};
+
+// Reads TSV / .lab text: `start end phoneme [confidence]` separated by tabs or spaces, '#'
+// comments and blank lines allowed. Checks times (finite, non-negative, end > start, sorted,
+// no overlaps) and phonemes; errors name `sourceName` and the line. Warnings go to `warnings`.
+PhonemeSchedule readSchedule(std::istream& in, const std::string& sourceName,
+                             const ScheduleReadOptions& options = {},
+                             std::vector<std::string>* warnings = nullptr);
+PhonemeSchedule readScheduleFile(const std::filesystem::path& file,
+                                 const ScheduleReadOptions& options = {},
+                                 std::vector<std::string>* warnings = nullptr);
+
+// Writes TSV, times with millisecond precision; confidence column when `withConfidence`.
+void writeSchedule(std::ostream& out, std::span<const PhonemeSegment> schedule,
+                   bool withConfidence = true);
+// JSON array of {"start","end","phoneme","confidence"}.
+void writeScheduleJson(std::ostream& out, std::span<const PhonemeSegment> schedule);
+
+}  // namespace lipsyncd

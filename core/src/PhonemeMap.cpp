@@ -1,0 +1,72 @@
+#include <lipsyncd/core.hpp>
+#include <lipsyncd/toml_table.hpp>
+
+#include <algorithm>
+#include <cctype>
+
+namespace lipsyncd {
+
+namespace {
+// Reads a symbol -> class table, checking every target is a class of the common set.
+std::unordered_map<std::string, std::string> readTable(const TomlTable& doc, const char* key) {
+    std::unordered_map<std::string, std::string> out;
+    const auto table = doc.optTable(key);
+    if (!table) return out;
+    const PhonemeSet& set = PhonemeSet::common();
+    for (const auto& symbol : table->keys()) {
+        std::string target = table->getString(symbol);
+        if (!set.find(target))
+            table->fail(symbol, "maps to '" + target + "', which is not a phoneme class");
+        out.emplace(symbol, std::move(target));
+    }
+    table->finish();
+    return out;
+}
+}  // namespace
+
+PhonemeMap PhonemeMap::load(const std::filesystem::path& file) {
+    const auto doc = TomlTable::parseFile(file);
+    PhonemeMap m;
+    m.name_ = doc.optString("name").value_or(file.stem().string());
+    doc.optString("description");
+    m.caseSensitive_ = doc.optBool("case_sensitive").value_or(true);
+    m.stripStressDigits_ = doc.optBool("strip_stress_digits").value_or(false);
+    m.ignored_ = doc.optStringArray("ignore").value_or(std::vector<std::string>{});
+    // Keys are stored normalised so lookups can normalise the symbol the same way.
+    for (auto& [k, v] : readTable(doc, "map")) m.exact_.emplace(m.normalise(k), v);
+    for (auto& [k, v] : readTable(doc, "nearest")) m.nearest_.emplace(m.normalise(k), v);
+    for (auto& s : m.ignored_) s = m.normalise(s);
+    doc.finish();
+    if (m.exact_.empty()) throw InputError(file.string(), 0, "phoneme map has an empty [map]");
+    return m;
+}
+
+PhonemeMap PhonemeMap::named(std::string_view nameOrPath) {
+    const std::filesystem::path given(nameOrPath);
+    if (given.has_extension()) return load(findDataFile(given));
+    return load(findDataFile(std::filesystem::path("phonemes") / (std::string(nameOrPath) + ".toml")));
+}
+
+std::string PhonemeMap::normalise(std::string_view symbol) const {
+    std::string s(symbol);
+    if (stripStressDigits_)
+        while (s.size() > 1 && std::isdigit(static_cast<unsigned char>(s.back()))) s.pop_back();
+    if (!caseSensitive_)
+        std::transform(s.begin(), s.end(), s.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return s;
+}
+
+std::optional<PhonemeMap::Result> PhonemeMap::map(std::string_view symbol) const {
+    const std::string key = normalise(symbol);
+    if (auto it = exact_.find(key); it != exact_.end()) return Result{it->second, false};
+    if (auto it = nearest_.find(key); it != nearest_.end()) return Result{it->second, true};
+    return std::nullopt;
+}
+
+bool PhonemeMap::isIgnored(std::string_view symbol) const {
+    const std::string key = normalise(symbol);
+    return std::find(ignored_.begin(), ignored_.end(), key) != ignored_.end();
+}
+
+}  // namespace lipsyncd

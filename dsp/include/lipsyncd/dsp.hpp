@@ -1,0 +1,345 @@
+// dsp: audio in, phoneme schedule out, by linear prediction (Lewis, shared/seeds/004).
+//
+//   AudioDecoder        libsndfile: WAV/FLAC/OGG/raw PCM, any rate and channel count → mono
+//                       float (mixed, or one chosen channel), read in blocks.
+//   StreamResampler     libsoxr in streaming mode → the analysis rate (10 kHz); reports delay.
+//   FrameAnalyzer       one frame: pre-emphasis, Hamming window, autocorrelation, lag window,
+//                       white-noise correction, Levinson–Durbin, LPC log spectrum, energy.
+//   TemplateSet         spectral templates per phoneme class (config/templates/*.json).
+//   FrameClassifier     nearest templates, energy gate with adaptive noise floor, voicing.
+//   Segmenter           frame labels → segments (hysteresis, minimum durations), streaming.
+//   StreamingAnalyzer   all of the above over a stream of samples at any rate, emitting
+//                       frames and closed segments as they happen.
+//   analyzeFile()       the whole chain over a file, for the command line and tests.
+//
+// Real-time paths (StreamingAnalyzer::push and everything under it) do not allocate once
+// constructed, except for the segments handed out.
+#pragma once
+
+#include <lipsyncd/core.hpp>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace lipsyncd::dsp {
+
+// ---------------------------------------------------------------------------------------------
+// Audio in.
+
+// Raw PCM description for pipes: "RATE:FORMAT:CHANNELS", FORMAT one of s8 u8 s16 s24 s32 f32 f64
+// (little-endian), e.g. "16000:s16:1".
+struct RawFormat {
+    int sampleRate = 0;
+    std::string sampleFormat;
+    int channels = 0;
+    static RawFormat parse(const std::string& spec);  // throws InputError
+};
+
+struct DecodeOptions {
+    // -1: mix all channels to mono; otherwise the 0-based channel to keep.
+    int channel = -1;
+};
+
+class AudioDecoder {
+public:
+    // Opens a file (type from its content) or, with `raw`, headerless PCM; "-" is stdin.
+    static AudioDecoder open(const std::filesystem::path& file, const DecodeOptions& options = {},
+                             const std::optional<RawFormat>& raw = std::nullopt);
+    AudioDecoder(AudioDecoder&&) noexcept;
+    AudioDecoder& operator=(AudioDecoder&&) noexcept;
+    ~AudioDecoder();
+
+    int sampleRate() const;
+    int channels() const;
+    // Frames in the file when known (not for pipes).
+    std::optional<std::int64_t> frames() const;
+    // Fills `out` with mono samples in [-1, 1]; returns how many, 0 at the end. Non-finite
+    // samples become 0 (and are counted). Throws InputError when the data stops making sense.
+    std::size_t read(std::span<float> out);
+    std::int64_t nonFiniteSamples() const;
+    const std::string& name() const;
+
+private:
+    struct State;
+    explicit AudioDecoder(std::unique_ptr<State> state);
+    std::unique_ptr<State> state_;
+};
+
+// Reads a whole file into memory (tests, training, small tools).
+struct MonoAudio {
+    std::vector<float> samples;
+    int sampleRate = 0;
+};
+MonoAudio readAudioFile(const std::filesystem::path& file, const DecodeOptions& options = {});
+// Writes 16-bit PCM WAV.
+void writeWavFile(const std::filesystem::path& file, std::span<const std::int16_t> samples,
+                  int sampleRate);
+void writeWavFile(const std::filesystem::path& file, std::span<const float> samples, int sampleRate);
+
+enum class ResamplerQuality { Low, Medium, High, VeryHigh };
+
+class StreamResampler {
+public:
+    StreamResampler(double inputRate, double outputRate,
+                    ResamplerQuality quality = ResamplerQuality::Medium,
+                    std::size_t maxBlock = 4096);
+    StreamResampler(StreamResampler&&) noexcept;
+    StreamResampler& operator=(StreamResampler&&) noexcept;
+    ~StreamResampler();
+
+    // Resamples one block (at most maxBlock samples); returns the output samples, which stay
+    // valid until the next call. An empty input with `flush` drains what is held back.
+    std::span<const float> process(std::span<const float> input, bool flush = false);
+    // The resampler's own delay in seconds (what it holds back), as libsoxr reports it.
+    double delaySeconds() const;
+    double inputRate() const { return inputRate_; }
+    double outputRate() const { return outputRate_; }
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+    double inputRate_, outputRate_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// LPC analysis of one frame.
+
+inline constexpr int kMaxOrder = 32;
+
+struct AnalysisConfig {
+    int analysisRate = 10000;      // Hz; Lewis analyses at 10 kHz
+    double hopSeconds = 0.010;     // 100 frames per second
+    double windowSeconds = 0.025;  // 25 ms Hamming window
+    int order = 12;                // 2 poles per kHz plus 2 for shape (Lewis; notes/dsp.md)
+    double preEmphasis = 0.97;
+    double lagWindowHz = 60.0;           // Gaussian lag window bandwidth (smooths the spectrum)
+    double whiteNoiseCorrection = 1e-4;  // r[0] *= 1 + ε (≈ −40 dB noise floor)
+    int spectrumBins = 32;               // log-magnitude points from 0 to analysisRate / 2
+    bool spectrumByFft = false;          // evaluate by FFT instead of directly (bench compares)
+
+    int hopSamples() const;
+    int windowSamples() const;
+    void validate() const;  // throws InputError naming the field
+};
+
+// Levinson–Durbin on autocorrelation r[0..order] (Makhoul 1975; Rabiner & Schafer 8.3.2).
+struct LpcResult {
+    std::array<float, kMaxOrder + 1> a{};   // A(z) = 1 + Σ a[i] z^-i, a[0] = 1
+    std::array<float, kMaxOrder> k{};       // reflection coefficients, |k| < 1
+    float predictionError = 0;              // E_p (same units as r[0])
+    float normalizedError = 1;              // E_p / r[0] in (0, 1]
+    int order = 0;                          // the order reached (less when stopped early)
+    bool stable = true;                     // false: a reflection coefficient reached |k| ≥ 1
+};
+LpcResult levinsonDurbin(std::span<const float> r, int order);
+
+struct FrameFeatures {
+    double time = 0;         // centre of the frame, seconds from the start of the input
+    float energyDb = -120;   // frame RMS in dBFS (before pre-emphasis)
+    float normalizedError = 1;
+    bool clipped = false;    // many samples at full scale
+    bool valid = false;      // false: silent or degenerate; spectrum is flat
+    LpcResult lpc;
+    std::vector<float> spectrum;  // log magnitude of 1/|A|, dB, spectrumBins points
+};
+
+class DirectLpcSpectrum;
+class FftLpcSpectrum;
+
+class FrameAnalyzer {
+public:
+    explicit FrameAnalyzer(const AnalysisConfig& config);
+    FrameAnalyzer(FrameAnalyzer&&) noexcept;
+    FrameAnalyzer& operator=(FrameAnalyzer&&) noexcept;
+    ~FrameAnalyzer();
+    // `frame`: windowSamples() samples at the analysis rate. Fills `out` without allocating
+    // (out.spectrum must have spectrumBins elements; see makeFeatures()).
+    void analyze(std::span<const float> frame, FrameFeatures& out);
+    FrameFeatures makeFeatures() const;
+    const AnalysisConfig& config() const { return config_; }
+
+private:
+    AnalysisConfig config_;
+    std::vector<float> window_, buffer_, lagWindow_;
+    std::unique_ptr<DirectLpcSpectrum> direct_;
+    std::unique_ptr<FftLpcSpectrum> fft_;
+    std::array<float, kMaxOrder + 1> r_{};
+};
+
+// ---------------------------------------------------------------------------------------------
+// Templates and classification.
+
+// Spectral templates: per class one or more log spectra (cluster means), on the grid of the
+// analysis configuration they were trained with, and per-bin weights for the distance.
+// File format: config/templates/README.md.
+struct TemplateSet {
+    struct ClassTemplates {
+        std::string phoneme;
+        std::vector<std::vector<float>> spectra;
+        std::size_t frames = 0;  // training frames behind these (for reports)
+    };
+    AnalysisConfig analysis;
+    std::vector<float> binWeights;  // distance weights per bin (inverse variance), sum = bins
+    std::vector<ClassTemplates> classes;
+    std::string description;
+
+    static TemplateSet load(const std::filesystem::path& file);  // validates; InputError
+    static TemplateSet loadDefault();                            // config/templates/default.json
+    void save(const std::filesystem::path& file) const;
+    void validate(const std::string& source) const;
+};
+
+struct FrameLabel {
+    double time = 0;
+    int phoneme = 0;  // index into the PhonemeSet
+    int runnerUp = 0;
+    float distance = 0, runnerUpDistance = 0;
+    float confidence = 0;  // in [0, 1], from the margin between best and runner-up
+    float energyDb = -120;
+    float noiseFloorDb = -120;
+    bool voiced = false;
+    bool silent = true;  // below the energy gate
+};
+
+struct ClassifierConfig {
+    float silenceMarginDb = 12;    // a frame is silent below noise floor + margin ...
+    float absoluteSilenceDb = -55; // ... or below this level whatever the floor
+    float voicingThreshold = 0.25; // normalised prediction error below this: voiced (Lewis)
+    float noiseFloorRiseDbPerSecond = 3;  // the floor follows quiet frames at once, rises slowly
+};
+
+class FrameClassifier {
+public:
+    FrameClassifier(const TemplateSet& templates, const PhonemeSet& set,
+                    const ClassifierConfig& config = {});
+    FrameLabel classify(const FrameFeatures& frame);
+    // Distance from the frame to each class (best template), indexed by phoneme set index;
+    // +inf for classes without templates. Valid after classify().
+    std::span<const float> distances() const { return distances_; }
+    void reset();
+
+private:
+    const TemplateSet* templates_;
+    const PhonemeSet* set_;
+    ClassifierConfig config_;
+    std::vector<int> classIndex_;  // template class -> phoneme set index
+    std::vector<float> distances_;
+    float noiseFloorDb_ = 0;
+    bool floorInitialised_ = false;
+    double lastTime_ = 0;
+};
+
+struct SegmenterConfig {
+    double minVowelSeconds = 0.05;      // shorter runs are flicker, not phonemes
+    double minConsonantSeconds = 0.03;
+    double minSilenceSeconds = 0.06;
+    float switchMargin = 0.0f;          // extra confidence a new class needs (hysteresis)
+};
+
+// Turns frame labels into segments. Streaming: push() frames as they come; closed segments
+// come out once no later frame can change them. The delay is bounded (delaySeconds()).
+class Segmenter {
+public:
+    Segmenter(const PhonemeSet& set, double hopSeconds, const SegmenterConfig& config = {});
+    // Returns the segments closed by this frame (usually none; at most a few).
+    std::span<const PhonemeSegment> push(const FrameLabel& label);
+    std::span<const PhonemeSegment> finish(double endTime);
+    double delaySeconds() const;
+
+private:
+    struct Run {
+        int phoneme;
+        double start, end;
+        float confidenceSum;
+        int frames;
+    };
+    void emit(const Run& run);
+    double minDuration(int phoneme) const;
+    bool tooShort(const Run& run) const;
+    void absorbIfFlicker(std::size_t closed);
+    void settle(bool final);
+
+    const PhonemeSet* set_;
+    double hop_;
+    SegmenterConfig config_;
+    std::vector<Run> pending_;  // runs not yet final
+    std::vector<PhonemeSegment> out_;
+    double emittedUntil_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The whole chain.
+
+struct FrontEndConfig {
+    AnalysisConfig analysis;  // overridden by the templates' own analysis settings
+    ClassifierConfig classifier;
+    SegmenterConfig segmenter;
+    ResamplerQuality resamplerQuality = ResamplerQuality::Medium;
+};
+
+class StreamingAnalyzer {
+public:
+    struct Frame {
+        FrameFeatures features;
+        FrameLabel label;
+    };
+    using FrameSink = std::function<void(const Frame&)>;
+    using SegmentSink = std::function<void(const PhonemeSegment&)>;
+
+    StreamingAnalyzer(const TemplateSet& templates, const PhonemeSet& set, double inputRate,
+                      const FrontEndConfig& config = {});
+    void onFrame(FrameSink sink) { frameSink_ = std::move(sink); }
+    void onSegment(SegmentSink sink) { segmentSink_ = std::move(sink); }
+
+    // Any block size. Sinks are called from inside.
+    void push(std::span<const float> samples);
+    void finish();
+    // From a sound entering push() to the segment that covers it closing: resampler delay, half
+    // a window, and the segmenter's hold.
+    double latencySeconds() const;
+    double resamplerDelaySeconds() const;
+
+private:
+    void analyzeReadyFrames();
+    void appendResampled(std::span<const float> out);
+
+    TemplateSet templates_;
+    const PhonemeSet* set_;
+    FrontEndConfig config_;
+    StreamResampler resampler_;
+    FrameAnalyzer analyzer_;
+    FrameClassifier classifier_;
+    Segmenter segmenter_;
+    FrameSink frameSink_;
+    SegmentSink segmentSink_;
+    std::vector<float> ring_;  // analysis-rate samples not yet consumed
+    std::size_t ringFill_ = 0;
+    std::int64_t consumed_ = 0;  // analysis-rate samples dropped from the front of ring_
+    std::int64_t produced_ = 0;  // analysis-rate samples produced so far
+    std::int64_t nextFrameStart_ = 0;
+    Frame frame_;
+};
+
+struct AnalysisResult {
+    PhonemeSchedule schedule;
+    std::vector<StreamingAnalyzer::Frame> frames;  // only when asked for
+    double durationSeconds = 0;
+    int inputRate = 0;
+    double resamplerDelaySeconds = 0;
+    std::int64_t nonFiniteSamples = 0;
+};
+
+AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet& templates,
+                           const PhonemeSet& set, const FrontEndConfig& config = {},
+                           const DecodeOptions& decode = {},
+                           const std::optional<RawFormat>& raw = std::nullopt,
+                           bool keepFrames = false);
+
+}  // namespace lipsyncd::dsp

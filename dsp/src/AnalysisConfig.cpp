@@ -1,0 +1,35 @@
+#include <lipsyncd/dsp.hpp>
+
+#include <cmath>
+
+namespace lipsyncd::dsp {
+
+int AnalysisConfig::hopSamples() const {
+    return static_cast<int>(std::lround(hopSeconds * analysisRate));
+}
+
+int AnalysisConfig::windowSamples() const {
+    return static_cast<int>(std::lround(windowSeconds * analysisRate));
+}
+
+void AnalysisConfig::validate() const {
+    auto bad = [](const std::string& field, const std::string& what) {
+        throw InputError("analysis." + field + ": " + what);
+    };
+    if (analysisRate < 4000 || analysisRate > 48000) bad("rate", "must be 4000..48000 Hz");
+    if (!(hopSeconds >= 0.002 && hopSeconds <= 0.05)) bad("hop", "must be 0.002..0.05 s");
+    if (!(windowSeconds >= hopSeconds && windowSeconds <= 0.1))
+        bad("window", "must be at least the hop and at most 0.1 s");
+    if (order < 2 || order > kMaxOrder) bad("order", "must be 2.." + std::to_string(kMaxOrder));
+    if (windowSamples() <= order) bad("window", "must hold more samples than the LPC order");
+    if (!(preEmphasis >= 0 && preEmphasis < 1)) bad("pre_emphasis", "must be in [0, 1)");
+    if (!(lagWindowHz >= 0 && lagWindowHz < analysisRate / 4.0))
+        bad("lag_window_hz", "must be in [0, rate/4)");
+    if (!(whiteNoiseCorrection >= 0 && whiteNoiseCorrection < 0.1))
+        bad("white_noise_correction", "must be in [0, 0.1)");
+    if (spectrumBins < 4 || spectrumBins > 512) bad("bins", "must be 4..512");
+    if (spectrumByFft && (spectrumBins & (spectrumBins - 1)) != 0)
+        bad("bins", "must be a power of two for FFT evaluation");
+}
+
+}  // namespace lipsyncd::dsp

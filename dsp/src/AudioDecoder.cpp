@@ -1,0 +1,179 @@
+// Decoding with libsndfile: files by content, raw PCM by description, stdin for pipes.
+#include <lipsyncd/dsp.hpp>
+
+#include <sndfile.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <unistd.h>
+
+namespace lipsyncd::dsp {
+
+namespace {
+constexpr std::size_t kBlockFrames = 4096;
+
+int rawSubtype(const std::string& f) {
+    if (f == "s8") return SF_FORMAT_PCM_S8;
+    if (f == "u8") return SF_FORMAT_PCM_U8;
+    if (f == "s16") return SF_FORMAT_PCM_16;
+    if (f == "s24") return SF_FORMAT_PCM_24;
+    if (f == "s32") return SF_FORMAT_PCM_32;
+    if (f == "f32") return SF_FORMAT_FLOAT;
+    if (f == "f64") return SF_FORMAT_DOUBLE;
+    return 0;
+}
+
+struct SndfileCloser {
+    void operator()(SNDFILE* f) const { sf_close(f); }
+};
+}  // namespace
+
+RawFormat RawFormat::parse(const std::string& spec) {
+    RawFormat f;
+    const auto a = spec.find(':');
+    const auto b = a == std::string::npos ? a : spec.find(':', a + 1);
+    if (b == std::string::npos)
+        throw InputError("--raw '" + spec + "': expected RATE:FORMAT:CHANNELS, e.g. 16000:s16:1");
+    try {
+        f.sampleRate = std::stoi(spec.substr(0, a));
+        f.channels = std::stoi(spec.substr(b + 1));
+    } catch (const std::exception&) {
+        throw InputError("--raw '" + spec + "': RATE and CHANNELS must be whole numbers");
+    }
+    f.sampleFormat = spec.substr(a + 1, b - a - 1);
+    if (f.sampleRate < 1000 || f.sampleRate > 384000)
+        throw InputError("--raw '" + spec + "': rate must be 1000..384000 Hz");
+    if (f.channels < 1 || f.channels > 64)
+        throw InputError("--raw '" + spec + "': channels must be 1..64");
+    if (!rawSubtype(f.sampleFormat))
+        throw InputError("--raw '" + spec + "': format must be one of s8 u8 s16 s24 s32 f32 f64");
+    return f;
+}
+
+struct AudioDecoder::State {
+    std::unique_ptr<SNDFILE, SndfileCloser> file;
+    SF_INFO info{};
+    std::string name;
+    int channel = -1;
+    std::vector<float> interleaved;
+    std::int64_t nonFinite = 0;
+};
+
+AudioDecoder::AudioDecoder(std::unique_ptr<State> state) : state_(std::move(state)) {}
+AudioDecoder::AudioDecoder(AudioDecoder&&) noexcept = default;
+AudioDecoder& AudioDecoder::operator=(AudioDecoder&&) noexcept = default;
+AudioDecoder::~AudioDecoder() = default;
+
+AudioDecoder AudioDecoder::open(const std::filesystem::path& file, const DecodeOptions& options,
+                                const std::optional<RawFormat>& raw) {
+    auto s = std::make_unique<State>();
+    s->name = file == "-" ? std::string("<stdin>") : file.string();
+    if (raw) {
+        s->info.samplerate = raw->sampleRate;
+        s->info.channels = raw->channels;
+        s->info.format = SF_FORMAT_RAW | rawSubtype(raw->sampleFormat) | SF_ENDIAN_LITTLE;
+    }
+    SNDFILE* f = nullptr;
+    if (file == "-") {
+        f = sf_open_fd(STDIN_FILENO, SFM_READ, &s->info, /*close_desc=*/0);
+    } else {
+        if (!std::filesystem::exists(file)) throw InputError(s->name + ": no such file");
+        if (std::filesystem::is_directory(file)) throw InputError(s->name + ": is a directory");
+        f = sf_open(file.c_str(), SFM_READ, &s->info);
+    }
+    if (!f)
+        throw InputError(s->name + ": cannot decode audio (" + sf_strerror(nullptr) + ")" +
+                         (raw ? "" : "; for headerless PCM give --raw RATE:FORMAT:CHANNELS"));
+    s->file.reset(f);
+    if (s->info.samplerate <= 0 || s->info.channels <= 0)
+        throw InputError(s->name + ": no sample rate or no channels in the header");
+    if (options.channel >= s->info.channels)
+        throw InputError(s->name + ": has " + std::to_string(s->info.channels) +
+                         " channel(s); --channel " + std::to_string(options.channel) +
+                         " does not exist (channels count from 0)");
+    s->channel = options.channel;
+    s->interleaved.resize(kBlockFrames * static_cast<std::size_t>(s->info.channels));
+    // libsndfile scales integer PCM to [-1, 1); floats are passed through as they are.
+    sf_command(f, SFC_SET_NORM_FLOAT, nullptr, SF_TRUE);
+    return AudioDecoder(std::move(s));
+}
+
+int AudioDecoder::sampleRate() const { return state_->info.samplerate; }
+int AudioDecoder::channels() const { return state_->info.channels; }
+const std::string& AudioDecoder::name() const { return state_->name; }
+std::int64_t AudioDecoder::nonFiniteSamples() const { return state_->nonFinite; }
+
+std::optional<std::int64_t> AudioDecoder::frames() const {
+    const bool seekable = state_->info.seekable && state_->name != "<stdin>";
+    if (!seekable || state_->info.frames <= 0 || state_->info.frames == SF_COUNT_MAX)
+        return std::nullopt;
+    return state_->info.frames;
+}
+
+std::size_t AudioDecoder::read(std::span<float> out) {
+    auto& s = *state_;
+    const auto channels = static_cast<std::size_t>(s.info.channels);
+    const std::size_t want = std::min(out.size(), kBlockFrames);
+    const auto got = sf_readf_float(s.file.get(), s.interleaved.data(), static_cast<sf_count_t>(want));
+    if (got < 0) throw InputError(s.name + ": read error (" + sf_strerror(s.file.get()) + ")");
+    const auto n = static_cast<std::size_t>(got);
+    for (std::size_t i = 0; i < n; ++i) {
+        const float* frame = &s.interleaved[i * channels];
+        float v = 0;
+        if (s.channel >= 0) {
+            v = frame[s.channel];
+        } else {
+            for (std::size_t c = 0; c < channels; ++c) v += frame[c];
+            v /= static_cast<float>(channels);
+        }
+        if (!std::isfinite(v)) {
+            ++s.nonFinite;
+            v = 0;
+        }
+        out[i] = std::clamp(v, -1.0f, 1.0f);
+    }
+    return n;
+}
+
+MonoAudio readAudioFile(const std::filesystem::path& file, const DecodeOptions& options) {
+    auto decoder = AudioDecoder::open(file, options);
+    MonoAudio audio;
+    audio.sampleRate = decoder.sampleRate();
+    if (auto n = decoder.frames()) audio.samples.reserve(static_cast<std::size_t>(*n));
+    std::vector<float> block(kBlockFrames);
+    while (const auto n = decoder.read(block))
+        audio.samples.insert(audio.samples.end(), block.begin(), block.begin() + n);
+    return audio;
+}
+
+namespace {
+template <typename Sample>
+void writeWav(const std::filesystem::path& file, std::span<const Sample> samples, int rate) {
+    SF_INFO info{};
+    info.samplerate = rate;
+    info.channels = 1;
+    info.format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
+    std::unique_ptr<SNDFILE, SndfileCloser> f(sf_open(file.c_str(), SFM_WRITE, &info));
+    if (!f) throw InputError(file.string() + ": cannot write (" + sf_strerror(nullptr) + ")");
+    sf_count_t written = 0;
+    if constexpr (std::is_same_v<Sample, float>)
+        written = sf_write_float(f.get(), samples.data(), static_cast<sf_count_t>(samples.size()));
+    else
+        written = sf_write_short(f.get(), samples.data(), static_cast<sf_count_t>(samples.size()));
+    if (written != static_cast<sf_count_t>(samples.size()))
+        throw InputError(file.string() + ": write failed (" + sf_strerror(f.get()) + ")");
+}
+}  // namespace
+
+void writeWavFile(const std::filesystem::path& file, std::span<const std::int16_t> samples,
+                  int sampleRate) {
+    writeWav(file, samples, sampleRate);
+}
+
+void writeWavFile(const std::filesystem::path& file, std::span<const float> samples,
+                  int sampleRate) {
+    writeWav(file, samples, sampleRate);
+}
+
+}  // namespace lipsyncd::dsp

@@ -1,0 +1,107 @@
+// Per-frame classification (Lewis: "classifying each speech frame by minimum Euclidean distance
+// of its short-term spectrum to the spectra of a set of phonemes"), with the distance weighted
+// per bin by inverse variance (Tohkura 1987; shared/notes/dsp.md), an energy gate over an
+// adaptive noise floor for silence, and voicing from the normalised prediction error (Lewis:
+// "normalized errors greater than about 0.1 typically reflect consonants").
+#include <lipsyncd/dsp.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace lipsyncd::dsp {
+
+namespace {
+// The floor never rises above this: loud steady noise must not gate out speech entirely.
+constexpr float kMaxNoiseFloorDb = -35.0f;
+constexpr float kInitialNoiseFloorDb = -70.0f;
+}  // namespace
+
+FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet& set,
+                                 const ClassifierConfig& config)
+    : templates_(&templates), set_(&set), config_(config) {
+    for (const auto& c : templates.classes) {
+        const auto idx = set.find(c.phoneme);
+        if (!idx) throw InputError("templates: class '" + c.phoneme + "' is not in the phoneme set");
+        classIndex_.push_back(static_cast<int>(*idx));
+    }
+    distances_.assign(set.size(), std::numeric_limits<float>::infinity());
+    reset();
+}
+
+void FrameClassifier::reset() {
+    noiseFloorDb_ = kInitialNoiseFloorDb;
+    floorInitialised_ = false;
+    lastTime_ = 0;
+}
+
+FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
+    FrameLabel label;
+    label.time = frame.time;
+    label.energyDb = frame.energyDb;
+    label.voiced = frame.valid && frame.normalizedError < config_.voicingThreshold;
+
+    // Noise floor: follows quiet frames down at once, creeps up slowly during sound.
+    const double dt = floorInitialised_ ? std::max(0.0, frame.time - lastTime_) : 0.0;
+    lastTime_ = frame.time;
+    floorInitialised_ = true;
+    if (frame.energyDb < noiseFloorDb_)
+        noiseFloorDb_ = frame.energyDb;
+    else
+        noiseFloorDb_ = std::min(kMaxNoiseFloorDb,
+                                 noiseFloorDb_ + config_.noiseFloorRiseDbPerSecond * static_cast<float>(dt));
+    label.noiseFloorDb = noiseFloorDb_;
+    const float gate = std::max(config_.absoluteSilenceDb, noiseFloorDb_ + config_.silenceMarginDb);
+
+    // Distances: weighted RMS difference in dB to the nearest template of each class.
+    std::fill(distances_.begin(), distances_.end(), std::numeric_limits<float>::infinity());
+    const auto& w = templates_->binWeights;
+    const std::size_t bins = w.size();
+    for (std::size_t c = 0; c < templates_->classes.size(); ++c) {
+        float best = std::numeric_limits<float>::infinity();
+        for (const auto& t : templates_->classes[c].spectra) {
+            float acc = 0;
+            for (std::size_t b = 0; b < bins; ++b) {
+                const float d = frame.spectrum[b] - t[b];
+                acc += w[b] * d * d;
+            }
+            best = std::min(best, acc);
+        }
+        float& slot = distances_[classIndex_[c]];
+        slot = std::min(slot, std::sqrt(best / static_cast<float>(bins)));
+    }
+
+    const int sil = static_cast<int>(set_->silence());
+    int first = -1, second = -1;
+    for (int i = 0; i < static_cast<int>(distances_.size()); ++i) {
+        if (!std::isfinite(distances_[i])) continue;
+        if (first < 0 || distances_[i] < distances_[first]) {
+            second = first;
+            first = i;
+        } else if (second < 0 || distances_[i] < distances_[second]) {
+            second = i;
+        }
+    }
+    if (first < 0) first = sil;
+    if (second < 0) second = first;
+    label.phoneme = first;
+    label.runnerUp = second;
+    label.distance = distances_[first];
+    label.runnerUpDistance = distances_[second];
+    const float margin = label.runnerUpDistance - label.distance;
+    label.confidence = std::isfinite(margin) && label.runnerUpDistance > 0
+                           ? std::clamp(margin / label.runnerUpDistance, 0.0f, 1.0f)
+                           : 0.0f;
+
+    label.silent = !frame.valid || frame.energyDb < gate;
+    if (label.silent) {
+        label.runnerUp = label.phoneme;
+        label.runnerUpDistance = label.distance;
+        label.phoneme = sil;
+        // Sure when far below the gate, unsure near it.
+        label.confidence = std::clamp((gate - frame.energyDb) / config_.silenceMarginDb, 0.0f, 1.0f);
+    }
+    return label;
+}
+
+}  // namespace lipsyncd::dsp

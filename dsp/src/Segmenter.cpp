@@ -1,0 +1,108 @@
+// Frame labels to segments. Runs of one class shorter than the class's minimum duration are
+// flicker and merge into the run before them (hysteresis in time; notes/dsp.md: a 120 ms hold
+// made viseme changes "markedly more natural"; phonemes need less). A run is final once the
+// run after it has reached its own minimum length: nothing later can then move the boundary
+// between them, so the delay is bounded by the longest minimum plus one hop.
+#include <lipsyncd/dsp.hpp>
+
+#include <algorithm>
+
+namespace lipsyncd::dsp {
+
+Segmenter::Segmenter(const PhonemeSet& set, double hopSeconds, const SegmenterConfig& config)
+    : set_(&set), hop_(hopSeconds), config_(config) {
+    pending_.reserve(16);
+    out_.reserve(16);
+}
+
+double Segmenter::minDuration(int phoneme) const {
+    if (phoneme == static_cast<int>(set_->silence())) return config_.minSilenceSeconds;
+    return (*set_)[static_cast<std::size_t>(phoneme)].vowel ? config_.minVowelSeconds
+                                                             : config_.minConsonantSeconds;
+}
+
+double Segmenter::delaySeconds() const {
+    return std::max({config_.minVowelSeconds, config_.minConsonantSeconds,
+                     config_.minSilenceSeconds}) +
+           hop_;
+}
+
+void Segmenter::emit(const Run& run) {
+    PhonemeSegment seg;
+    seg.start = std::max(run.start, emittedUntil_);
+    seg.end = run.end;
+    seg.phoneme = (*set_)[static_cast<std::size_t>(run.phoneme)].name;
+    seg.confidence = run.frames > 0 ? run.confidenceSum / run.frames : 0.0f;
+    if (seg.end > seg.start) out_.push_back(std::move(seg));
+    emittedUntil_ = run.end;
+}
+
+bool Segmenter::tooShort(const Run& run) const {
+    return run.end - run.start < minDuration(run.phoneme) - 1e-9;
+}
+
+// Called when the run at `closed` has ended. Only that run can be flicker: every run before
+// it was checked when it closed.
+void Segmenter::absorbIfFlicker(std::size_t closed) {
+    Run& run = pending_[closed];
+    if (!tooShort(run) || pending_.size() < 2) return;
+    if (closed > 0) {
+        Run& before = pending_[closed - 1];
+        before.end = run.end;
+        pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(closed));
+        // The runs either side of the flicker may be one class: join them.
+        if (closed < pending_.size() && pending_[closed].phoneme == before.phoneme) {
+            before.end = pending_[closed].end;
+            before.confidenceSum += pending_[closed].confidenceSum;
+            before.frames += pending_[closed].frames;
+            pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(closed));
+        }
+    } else {
+        pending_[1].start = run.start;
+        pending_.erase(pending_.begin());
+    }
+}
+
+void Segmenter::settle(bool final) {
+    if (final && !pending_.empty()) absorbIfFlicker(pending_.size() - 1);
+    std::size_t emitted = 0;
+    while (pending_.size() - emitted >= 2 && !tooShort(pending_[emitted + 1]))
+        emit(pending_[emitted++]);
+    if (final)
+        while (emitted < pending_.size()) emit(pending_[emitted++]);
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(emitted));
+}
+
+std::span<const PhonemeSegment> Segmenter::push(const FrameLabel& label) {
+    out_.clear();
+    int phoneme = label.phoneme;
+    // Hysteresis in confidence: an unsure frame does not start a new run.
+    if (!pending_.empty() && phoneme != pending_.back().phoneme &&
+        label.confidence < config_.switchMargin)
+        phoneme = pending_.back().phoneme;
+    const double start = std::max(0.0, label.time - hop_ / 2);
+    const double end = label.time + hop_ / 2;
+    if (!pending_.empty() && pending_.back().phoneme == phoneme) {
+        auto& run = pending_.back();
+        run.end = end;
+        run.confidenceSum += label.confidence;
+        ++run.frames;
+    } else {
+        const double runStart = pending_.empty() ? (emittedUntil_ > 0 ? emittedUntil_ : start)
+                                                 : pending_.back().end;
+        pending_.push_back({phoneme, runStart, end, label.confidence, 1});
+        if (pending_.size() >= 2) absorbIfFlicker(pending_.size() - 2);
+        settle(false);
+    }
+    return out_;
+}
+
+std::span<const PhonemeSegment> Segmenter::finish(double endTime) {
+    out_.clear();
+    if (!pending_.empty()) pending_.back().end = std::max(pending_.back().end, endTime);
+    settle(true);
+    if (!out_.empty()) out_.back().end = std::max(out_.back().end, endTime);
+    return out_;
+}
+
+}  // namespace lipsyncd::dsp

@@ -1,0 +1,151 @@
+// Spectral templates as data: JSON under config/templates/ (format in its README.md).
+#include <lipsyncd/dsp.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+
+namespace lipsyncd::dsp {
+
+namespace {
+using nlohmann::json;
+constexpr const char* kFormat = "lipsyncd-templates";
+constexpr int kVersion = 1;
+
+// Reads a member with a message naming the JSON path when it is missing or of the wrong type.
+template <typename T>
+T member(const json& j, const std::string& key, const std::string& path, const std::string& source) {
+    if (!j.is_object() || !j.contains(key))
+        throw InputError(source, 0, "missing field '" + path + key + "'");
+    try {
+        return j.at(key).get<T>();
+    } catch (const json::exception&) {
+        throw InputError(source, 0, "field '" + path + key + "' has the wrong type (" +
+                                        std::string(j.at(key).type_name()) + ")");
+    }
+}
+
+AnalysisConfig readAnalysis(const json& a, const std::string& source) {
+    AnalysisConfig c;
+    const std::string p = "analysis.";
+    c.analysisRate = member<int>(a, "rate", p, source);
+    c.hopSeconds = member<double>(a, "hop", p, source);
+    c.windowSeconds = member<double>(a, "window", p, source);
+    c.order = member<int>(a, "order", p, source);
+    c.preEmphasis = member<double>(a, "pre_emphasis", p, source);
+    c.lagWindowHz = member<double>(a, "lag_window_hz", p, source);
+    c.whiteNoiseCorrection = member<double>(a, "white_noise_correction", p, source);
+    c.spectrumBins = member<int>(a, "bins", p, source);
+    try {
+        c.validate();
+    } catch (const InputError& e) {
+        throw InputError(source, 0, e.what());
+    }
+    return c;
+}
+
+json writeAnalysis(const AnalysisConfig& c) {
+    return {{"rate", c.analysisRate},         {"hop", c.hopSeconds},
+            {"window", c.windowSeconds},      {"order", c.order},
+            {"pre_emphasis", c.preEmphasis},  {"lag_window_hz", c.lagWindowHz},
+            {"white_noise_correction", c.whiteNoiseCorrection},
+            {"bins", c.spectrumBins}};
+}
+
+std::vector<float> rounded(const std::vector<float>& v) {
+    std::vector<float> out(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) out[i] = std::round(v[i] * 1000.0f) / 1000.0f;
+    return out;
+}
+}  // namespace
+
+void TemplateSet::validate(const std::string& source) const {
+    const auto bins = static_cast<std::size_t>(analysis.spectrumBins);
+    if (binWeights.size() != bins)
+        throw InputError(source, 0, "bin_weights has " + std::to_string(binWeights.size()) +
+                                        " values, analysis.bins is " + std::to_string(bins));
+    for (std::size_t b = 0; b < bins; ++b)
+        if (!(binWeights[b] >= 0) || !std::isfinite(binWeights[b]))
+            throw InputError(source, 0, "bin_weights[" + std::to_string(b) + "] must be >= 0");
+    if (classes.empty()) throw InputError(source, 0, "no classes");
+    const PhonemeSet& set = PhonemeSet::common();
+    for (std::size_t c = 0; c < classes.size(); ++c) {
+        const auto& cls = classes[c];
+        const std::string where = "classes[" + std::to_string(c) + "] ('" + cls.phoneme + "')";
+        if (!set.find(cls.phoneme))
+            throw InputError(source, 0, where + ": '" + cls.phoneme + "' is not a phoneme class");
+        for (std::size_t d = 0; d < c; ++d)
+            if (classes[d].phoneme == cls.phoneme)
+                throw InputError(source, 0, where + ": class listed twice");
+        if (cls.spectra.empty()) throw InputError(source, 0, where + ": no spectra");
+        for (std::size_t s = 0; s < cls.spectra.size(); ++s) {
+            if (cls.spectra[s].size() != bins)
+                throw InputError(source, 0, where + ".spectra[" + std::to_string(s) + "] has " +
+                                                std::to_string(cls.spectra[s].size()) +
+                                                " values, expected " + std::to_string(bins));
+            for (float v : cls.spectra[s])
+                if (!std::isfinite(v) || std::abs(v) > 200)
+                    throw InputError(source, 0, where + ".spectra[" + std::to_string(s) +
+                                                    "]: values must be finite dB within ±200");
+        }
+    }
+}
+
+TemplateSet TemplateSet::load(const std::filesystem::path& file) {
+    const std::string source = file.string();
+    std::ifstream in(file);
+    if (!in) throw InputError(source + ": cannot open");
+    json j;
+    try {
+        j = json::parse(in);
+    } catch (const json::parse_error& e) {
+        throw InputError(source, 0, std::string("not valid JSON: ") + e.what());
+    }
+    if (member<std::string>(j, "format", "", source) != kFormat)
+        throw InputError(source, 0, std::string("field 'format' must be \"") + kFormat + "\"");
+    if (const int v = member<int>(j, "version", "", source); v != kVersion)
+        throw InputError(source, 0, "template format version " + std::to_string(v) +
+                                        " is not supported (this build reads " +
+                                        std::to_string(kVersion) + ")");
+    TemplateSet t;
+    t.description = j.value("description", "");
+    t.analysis = readAnalysis(member<json>(j, "analysis", "", source), source);
+    t.binWeights = member<std::vector<float>>(j, "bin_weights", "", source);
+    const auto classes = member<json>(j, "classes", "", source);
+    if (!classes.is_array()) throw InputError(source, 0, "field 'classes' must be an array");
+    for (std::size_t i = 0; i < classes.size(); ++i) {
+        const std::string p = "classes[" + std::to_string(i) + "].";
+        ClassTemplates c;
+        c.phoneme = member<std::string>(classes[i], "phoneme", p, source);
+        c.spectra = member<std::vector<std::vector<float>>>(classes[i], "spectra", p, source);
+        c.frames = classes[i].value("frames", std::size_t{0});
+        t.classes.push_back(std::move(c));
+    }
+    t.validate(source);
+    return t;
+}
+
+TemplateSet TemplateSet::loadDefault() { return load(findDataFile("templates/default.json")); }
+
+void TemplateSet::save(const std::filesystem::path& file) const {
+    validate(file.string());
+    json classesJson = json::array();
+    for (const auto& c : classes) {
+        json spectra = json::array();
+        for (const auto& s : c.spectra) spectra.push_back(rounded(s));
+        classesJson.push_back({{"phoneme", c.phoneme}, {"frames", c.frames}, {"spectra", spectra}});
+    }
+    const json j = {{"format", kFormat},
+                    {"version", kVersion},
+                    {"description", description},
+                    {"analysis", writeAnalysis(analysis)},
+                    {"bin_weights", rounded(binWeights)},
+                    {"classes", classesJson}};
+    std::ofstream out(file);
+    if (!out) throw InputError(file.string() + ": cannot write");
+    out << j.dump(1) << '\n';
+    if (!out) throw InputError(file.string() + ": write failed");
+}
+
+}  // namespace lipsyncd::dsp

@@ -1,0 +1,82 @@
+#include <lipsyncd/tts.hpp>
+
+#include <espeak-ng/speak_lib.h>
+
+#include <atomic>
+#include <cstring>
+
+namespace lipsyncd {
+
+namespace {
+
+std::atomic<bool> gInstanceAlive{false};
+
+// Collects one synthesis: samples, and a phoneme event stream turned into segments.
+struct Collector {
+    std::vector<std::int16_t>* samples;
+    std::vector<std::pair<double, std::string>> events;  // (time s, mnemonic)
+};
+
+int onSynth(short* wav, int count, espeak_EVENT* events) {
+    for (espeak_EVENT* e = events; e && e->type != espeakEVENT_LIST_TERMINATED; ++e) {
+        auto* c = static_cast<Collector*>(e->user_data);
+        if (!c) continue;
+        if (e->type == espeakEVENT_PHONEME) {
+            char name[9] = {};
+            std::memcpy(name, e->id.string, 8);
+            c->events.emplace_back(e->audio_position / 1000.0, name);
+        }
+        if (wav && count > 0 && c->samples) {
+            c->samples->insert(c->samples->end(), wav, wav + count);
+            wav = nullptr;  // samples belong to the whole callback, add them once
+        }
+    }
+    return 0;  // continue synthesis
+}
+
+}  // namespace
+
+EspeakSynthesizer::EspeakSynthesizer(const std::string& dataPath) {
+    if (gInstanceAlive.exchange(true))
+        throw std::runtime_error("espeak-ng: only one synthesiser can exist at a time");
+    sampleRate_ = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 200,
+                                    dataPath.empty() ? nullptr : dataPath.c_str(),
+                                    espeakINITIALIZE_PHONEME_EVENTS | espeakINITIALIZE_DONT_EXIT);
+    if (sampleRate_ <= 0) {
+        gInstanceAlive = false;
+        throw std::runtime_error("espeak-ng: initialisation failed (is espeak-ng-data installed?)");
+    }
+    espeak_SetSynthCallback(onSynth);
+}
+
+EspeakSynthesizer::~EspeakSynthesizer() {
+    espeak_Terminate();
+    gInstanceAlive = false;
+}
+
+SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request) {
+    if (espeak_SetVoiceByName(request.voice.c_str()) != EE_OK)
+        throw InputError("espeak-ng: unknown voice '" + request.voice +
+                         "' (list them with: espeak-ng --voices)");
+    if (request.wordsPerMinute > 0) espeak_SetParameter(espeakRATE, request.wordsPerMinute, 0);
+    if (request.pitch >= 0) espeak_SetParameter(espeakPITCH, request.pitch, 0);
+
+    SynthesizedSpeech out;
+    out.sampleRate = sampleRate_;
+    Collector collector{&out.samples, {}};
+    const auto rc = espeak_Synth(request.text.c_str(), request.text.size() + 1, 0, POS_CHARACTER,
+                                 0, espeakCHARS_UTF8, nullptr, &collector);
+    if (rc != EE_OK) throw std::runtime_error("espeak-ng: synthesis failed");
+    espeak_Synchronize();
+
+    const double total = static_cast<double>(out.samples.size()) / sampleRate_;
+    auto& ev = collector.events;
+    for (std::size_t i = 0; i < ev.size(); ++i) {
+        const double start = std::min(ev[i].first, total);
+        const double end = i + 1 < ev.size() ? std::min(ev[i + 1].first, total) : total;
+        if (end > start) out.phonemes.push_back({start, end, ev[i].second, 1.0f});
+    }
+    return out;
+}
+
+}  // namespace lipsyncd
