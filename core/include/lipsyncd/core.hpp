@@ -6,6 +6,8 @@
 //                   the set.
 //   PhonemeSchedule timed segments (start, end, phoneme, confidence): the output of the front
 //                   end and the input of the runtime; read and written as TSV (DESIGN.md).
+//   PoseTrack       pose weights over time (one value per pose per output frame): the output of
+//                   the runtime and the input of the actuator stage; CSV `time,<pose>,...`.
 //   InputError      what every loader throws: a message that names the file, line and field.
 //
 // All of these are plain values, loaded from files under config/ and validated on load.
@@ -139,5 +141,28 @@ void writeSchedule(std::ostream& out, std::span<const PhonemeSegment> schedule,
                    bool withConfidence = true);
 // JSON array of {"start","end","phoneme","confidence"}.
 void writeScheduleJson(std::ostream& out, std::span<const PhonemeSegment> schedule);
+
+// ---------------------------------------------------------------------------------------------
+// Pose weights.
+
+struct PoseTrack {
+    std::vector<std::string> poses;
+    std::vector<double> times;  // seconds, increasing
+    std::vector<float> values;  // frame-major: values[frame * poses.size() + pose]
+
+    std::size_t frames() const { return times.size(); }
+    std::span<const float> frame(std::size_t f) const {
+        return std::span<const float>(values).subspan(f * poses.size(), poses.size());
+    }
+    std::optional<std::size_t> pose(std::string_view name) const;
+    void append(double time, std::span<const float> weights);  // weights.size() == poses.size()
+};
+
+// CSV with header `time,<pose>,<pose>,...`. Times must be finite and increasing; values may be
+// non-finite ("nan", "inf": the actuator stage holds the last good value) and are otherwise
+// taken as they are (the actuator stage clamps). Errors name the line and column.
+PoseTrack readPoseTrackCsv(std::istream& in, const std::string& sourceName);
+PoseTrack readPoseTrackCsvFile(const std::filesystem::path& file);  // "-" is stdin
+void writePoseTrackCsv(std::ostream& out, const PoseTrack& track);
 
 }  // namespace lipsyncd
