@@ -17,6 +17,10 @@ int main(int argc, char** argv) {
     app.fallthrough(false);
 
     using namespace lipsyncd::cli;
+    addAnalyzeCommand(app);
+    addEvalCommand(app);
+    addTrainCommand(app);
+    addCalibrateCommand(app);
     addSayCommand(app);
 
     try {

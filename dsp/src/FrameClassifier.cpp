@@ -26,6 +26,7 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
         classIndex_.push_back(static_cast<int>(*idx));
     }
     distances_.assign(set.size(), std::numeric_limits<float>::infinity());
+    sil_ = static_cast<int>(set.silence());
     reset();
 }
 
@@ -55,6 +56,13 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
 
     // Distances: weighted RMS difference in dB to the nearest template of each class.
     std::fill(distances_.begin(), distances_.end(), std::numeric_limits<float>::infinity());
+    if (!frame.valid) {  // digital silence or a degenerate frame: nothing to compare
+        label.phoneme = label.runnerUp = sil_;
+        label.distance = label.runnerUpDistance = 0;
+        label.confidence = 1;
+        label.silent = true;
+        return label;
+    }
     const auto& w = templates_->binWeights;
     const std::size_t bins = w.size();
     for (std::size_t c = 0; c < templates_->classes.size(); ++c) {
@@ -71,7 +79,7 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         slot = std::min(slot, std::sqrt(best / static_cast<float>(bins)));
     }
 
-    const int sil = static_cast<int>(set_->silence());
+    const int sil = sil_;
     int first = -1, second = -1;
     for (int i = 0; i < static_cast<int>(distances_.size()); ++i) {
         if (!std::isfinite(distances_[i])) continue;

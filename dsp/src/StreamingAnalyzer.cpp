@@ -1,20 +1,17 @@
-// The front end over a stream: resample to the analysis rate, cut frames every hop, analyse,
-// classify, segment. Buffers are sized at construction; push() does not allocate.
+// The front end over a stream: frames (FrameStream), classification, segmentation.
 #include <lipsyncd/dsp.hpp>
-
-#include <algorithm>
-#include <cstring>
 
 namespace lipsyncd::dsp {
 
 namespace {
-constexpr std::size_t kMaxInputBlock = 4096;
+constexpr std::size_t kReadBlock = 4096;
 
 FrontEndConfig withTemplateAnalysis(FrontEndConfig config, const TemplateSet& templates) {
     // Templates are only comparable with spectra made exactly as theirs were.
     const bool fft = config.analysis.spectrumByFft;
+    const int bins = templates.analysis.spectrumBins;
     config.analysis = templates.analysis;
-    config.analysis.spectrumByFft = fft && (templates.analysis.spectrumBins & (templates.analysis.spectrumBins - 1)) == 0;
+    config.analysis.spectrumByFft = fft && (bins & (bins - 1)) == 0;
     return config;
 }
 }  // namespace
@@ -24,81 +21,33 @@ StreamingAnalyzer::StreamingAnalyzer(const TemplateSet& templates, const Phoneme
     : templates_(templates),
       set_(&set),
       config_(withTemplateAnalysis(config, templates)),
-      resampler_(inputRate, config_.analysis.analysisRate, config_.resamplerQuality, kMaxInputBlock),
-      analyzer_(config_.analysis),
+      frames_(config_.analysis, inputRate, config_.resamplerQuality),
       classifier_(templates_, set, config_.classifier),
       segmenter_(set, config_.analysis.hopSeconds, config_.segmenter) {
-    const auto window = static_cast<std::size_t>(config_.analysis.windowSamples());
-    const auto maxOut = static_cast<std::size_t>(
-        kMaxInputBlock * static_cast<double>(config_.analysis.analysisRate) / inputRate + 8192);
-    ring_.assign(window + maxOut, 0.0f);
-    frame_.features = analyzer_.makeFeatures();
+    frame_.features = FrameAnalyzer(config_.analysis).makeFeatures();
+    featureSink_ = [this](const FrameFeatures& f) { onFeatures(f); };
 }
 
-double StreamingAnalyzer::resamplerDelaySeconds() const { return resampler_.delaySeconds(); }
-
 double StreamingAnalyzer::latencySeconds() const {
-    return resampler_.delaySeconds() + config_.analysis.windowSeconds +
+    return frames_.resamplerDelaySeconds() + config_.analysis.windowSeconds +
            segmenter_.delaySeconds();
 }
 
-void StreamingAnalyzer::analyzeReadyFrames() {
-    const auto window = static_cast<std::int64_t>(config_.analysis.windowSamples());
-    const auto hop = static_cast<std::int64_t>(config_.analysis.hopSamples());
-    const double rate = config_.analysis.analysisRate;
-    while (nextFrameStart_ + window <= produced_) {
-        const auto offset = static_cast<std::size_t>(nextFrameStart_ - consumed_);
-        frame_.features.time = (static_cast<double>(nextFrameStart_) + window / 2.0) / rate;
-        analyzer_.analyze(std::span<const float>(ring_.data() + offset, static_cast<std::size_t>(window)),
-                          frame_.features);
-        frame_.label = classifier_.classify(frame_.features);
-        if (frameSink_) frameSink_(frame_);
-        for (const auto& seg : segmenter_.push(frame_.label))
-            if (segmentSink_) segmentSink_(seg);
-        nextFrameStart_ += hop;
+void StreamingAnalyzer::onFeatures(const FrameFeatures& features) {
+    frame_.label = classifier_.classify(features);
+    if (frameSink_) {
+        frame_.features = features;
+        frameSink_(frame_);
     }
-    // Drop what no later frame needs.
-    const auto keepFrom = static_cast<std::size_t>(std::max<std::int64_t>(0, nextFrameStart_ - consumed_));
-    const std::size_t drop = std::min(keepFrom, ringFill_);
-    if (drop > 0) {
-        std::memmove(ring_.data(), ring_.data() + drop, (ringFill_ - drop) * sizeof(float));
-        ringFill_ -= drop;
-        consumed_ += static_cast<std::int64_t>(drop);
-    }
+    for (const auto& seg : segmenter_.push(frame_.label))
+        if (segmentSink_) segmentSink_(seg);
 }
 
-void StreamingAnalyzer::appendResampled(std::span<const float> out) {
-    std::size_t done = 0;
-    while (done < out.size()) {
-        const std::size_t n = std::min(out.size() - done, ring_.size() - ringFill_);
-        std::memcpy(ring_.data() + ringFill_, out.data() + done, n * sizeof(float));
-        ringFill_ += n;
-        produced_ += static_cast<std::int64_t>(n);
-        done += n;
-        analyzeReadyFrames();
-    }
-}
-
-void StreamingAnalyzer::push(std::span<const float> samples) {
-    while (!samples.empty()) {
-        const auto block = samples.first(std::min(samples.size(), kMaxInputBlock));
-        appendResampled(resampler_.process(block));
-        samples = samples.subspan(block.size());
-    }
-}
+void StreamingAnalyzer::push(std::span<const float> samples) { frames_.push(samples, featureSink_); }
 
 void StreamingAnalyzer::finish() {
-    // Drain the resampler, then pad with silence so the last partial window is analysed.
-    for (;;) {
-        const auto out = resampler_.process({}, true);
-        if (out.empty()) break;
-        appendResampled(out);
-    }
-    const double endTime = static_cast<double>(produced_) / config_.analysis.analysisRate;
-    // Half a window of silence lets every frame centred inside the audio be analysed.
-    const std::vector<float> padding(static_cast<std::size_t>(config_.analysis.windowSamples() / 2), 0.0f);
-    appendResampled(padding);
-    for (const auto& seg : segmenter_.finish(endTime))
+    frames_.finish(featureSink_);
+    for (const auto& seg : segmenter_.finish(frames_.endTime()))
         if (segmentSink_) segmentSink_(seg);
 }
 
@@ -113,7 +62,7 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     analyzer.onSegment([&](const PhonemeSegment& s) { result.schedule.push_back(s); });
     if (keepFrames)
         analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) { result.frames.push_back(f); });
-    std::vector<float> block(kMaxInputBlock);
+    std::vector<float> block(kReadBlock);
     std::int64_t total = 0;
     while (const auto n = decoder.read(block)) {
         analyzer.push(std::span<const float>(block.data(), n));

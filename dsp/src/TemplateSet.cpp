@@ -53,9 +53,11 @@ json writeAnalysis(const AnalysisConfig& c) {
             {"bins", c.spectrumBins}};
 }
 
-std::vector<float> rounded(const std::vector<float>& v) {
-    std::vector<float> out(v.size());
-    for (std::size_t i = 0; i < v.size(); ++i) out[i] = std::round(v[i] * 1000.0f) / 1000.0f;
+// Three decimals (0.001 dB is far below anything a distance can tell) as doubles, so the file
+// shows 1.034 rather than the float's 1.034000039100647.
+std::vector<double> rounded(const std::vector<float>& v) {
+    std::vector<double> out(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) out[i] = std::round(static_cast<double>(v[i]) * 1000.0) / 1000.0;
     return out;
 }
 }  // namespace

@@ -34,6 +34,35 @@ int onSynth(short* wav, int count, espeak_EVENT* events) {
     return 0;  // continue synthesis
 }
 
+// The voice file for a language code ("en-gb" -> "gmw/en"): espeak_SetVoiceByName knows voice
+// names and file names, but users name voices by language, as the espeak-ng command does.
+std::string voiceFileForLanguage(const std::string& language) {
+    const espeak_VOICE** voices = espeak_ListVoices(nullptr);
+    const espeak_VOICE* best = nullptr;
+    int bestPriority = 1000;
+    for (; voices && *voices; ++voices) {
+        // `languages` is a list of (priority byte, NUL-terminated code), ended by a zero byte.
+        for (const char* p = (*voices)->languages; p && *p; p += std::strlen(p + 1) + 2) {
+            const int priority = static_cast<unsigned char>(*p);
+            if (language == p + 1 && priority < bestPriority && (*voices)->identifier &&
+                std::strncmp((*voices)->identifier, "mb/", 3) != 0) {  // mbrola voices need extra data
+                best = *voices;
+                bestPriority = priority;
+            }
+        }
+    }
+    return best ? best->identifier : "";
+}
+
+bool selectVoice(const std::string& voice) {
+    if (espeak_SetVoiceByName(voice.c_str()) == EE_OK) return true;
+    const auto plus = voice.find('+');
+    const std::string file = voiceFileForLanguage(voice.substr(0, plus));
+    if (file.empty()) return false;
+    const std::string withVariant = plus == std::string::npos ? file : file + voice.substr(plus);
+    return espeak_SetVoiceByName(withVariant.c_str()) == EE_OK;
+}
+
 }  // namespace
 
 EspeakSynthesizer::EspeakSynthesizer(const std::string& dataPath) {
@@ -55,7 +84,7 @@ EspeakSynthesizer::~EspeakSynthesizer() {
 }
 
 SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request) {
-    if (espeak_SetVoiceByName(request.voice.c_str()) != EE_OK)
+    if (!selectVoice(request.voice))
         throw InputError("espeak-ng: unknown voice '" + request.voice +
                          "' (list them with: espeak-ng --voices)");
     if (request.wordsPerMinute > 0) espeak_SetParameter(espeakRATE, request.wordsPerMinute, 0);

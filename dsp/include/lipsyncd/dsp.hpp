@@ -231,6 +231,7 @@ private:
     ClassifierConfig config_;
     std::vector<int> classIndex_;  // template class -> phoneme set index
     std::vector<float> distances_;
+    int sil_ = 0;
     float noiseFloorDb_ = 0;
     bool floorInitialised_ = false;
     double lastTime_ = 0;
@@ -284,6 +285,40 @@ struct FrontEndConfig {
     ResamplerQuality resamplerQuality = ResamplerQuality::Medium;
 };
 
+// Resampling and framing: samples at any rate in, analysed frames (features) out, every hop.
+class FrameStream {
+public:
+    using Sink = std::function<void(const FrameFeatures&)>;
+    FrameStream(const AnalysisConfig& config, double inputRate,
+                ResamplerQuality quality = ResamplerQuality::Medium);
+    // Any block size; `sink` is called for every frame completed.
+    void push(std::span<const float> samples, const Sink& sink);
+    // Drains the resampler and analyses the frames centred inside the audio.
+    void finish(const Sink& sink);
+    double endTime() const;  // seconds of audio seen (at the analysis rate)
+    double resamplerDelaySeconds() const { return resampler_.delaySeconds(); }
+    const AnalysisConfig& config() const { return analyzer_.config(); }
+
+private:
+    void append(std::span<const float> resampled, const Sink& sink);
+    void analyzeReadyFrames(const Sink& sink);
+
+    StreamResampler resampler_;
+    FrameAnalyzer analyzer_;
+    FrameFeatures features_;
+    std::vector<float> buffer_;  // analysis-rate samples not yet consumed
+    std::size_t fill_ = 0;
+    std::int64_t consumed_ = 0;  // analysis-rate samples dropped from the front of buffer_
+    std::int64_t produced_ = 0;  // analysis-rate samples produced so far
+    std::int64_t nextFrameStart_ = 0;
+    double endTime_ = 0;
+};
+
+// Features of every frame of a file (training, calibration).
+std::vector<FrameFeatures> analyzeFrames(const std::filesystem::path& file,
+                                         const AnalysisConfig& config,
+                                         const DecodeOptions& decode = {});
+
 class StreamingAnalyzer {
 public:
     struct Frame {
@@ -301,29 +336,23 @@ public:
     // Any block size. Sinks are called from inside.
     void push(std::span<const float> samples);
     void finish();
-    // From a sound entering push() to the segment that covers it closing: resampler delay, half
-    // a window, and the segmenter's hold.
+    // From a sound entering push() to the segment that covers it closing: resampler delay, a
+    // window, and the segmenter's hold.
     double latencySeconds() const;
-    double resamplerDelaySeconds() const;
+    double resamplerDelaySeconds() const { return frames_.resamplerDelaySeconds(); }
 
 private:
-    void analyzeReadyFrames();
-    void appendResampled(std::span<const float> out);
+    void onFeatures(const FrameFeatures& features);
 
     TemplateSet templates_;
     const PhonemeSet* set_;
     FrontEndConfig config_;
-    StreamResampler resampler_;
-    FrameAnalyzer analyzer_;
+    FrameStream frames_;
     FrameClassifier classifier_;
     Segmenter segmenter_;
     FrameSink frameSink_;
     SegmentSink segmentSink_;
-    std::vector<float> ring_;  // analysis-rate samples not yet consumed
-    std::size_t ringFill_ = 0;
-    std::int64_t consumed_ = 0;  // analysis-rate samples dropped from the front of ring_
-    std::int64_t produced_ = 0;  // analysis-rate samples produced so far
-    std::int64_t nextFrameStart_ = 0;
+    FrameStream::Sink featureSink_;
     Frame frame_;
 };
 
@@ -335,6 +364,52 @@ struct AnalysisResult {
     double resamplerDelaySeconds = 0;
     std::int64_t nonFiniteSamples = 0;
 };
+
+// ---------------------------------------------------------------------------------------------
+// Training and evaluation.
+
+struct TrainingOptions {
+    AnalysisConfig analysis;
+    int clustersPerClass = 3;        // cluster means per class (paper 001, section 4: a cluster
+                                     // per phoneme; more than one catches speaker variety)
+    std::size_t minFramesPerCluster = 40;
+    double boundaryMarginSeconds = 0.02;  // frames this near a label boundary are transitions
+    float maxBelowPeakDb = 35;       // frames this far below the utterance's peak are not speech
+    std::uint32_t seed = 1;          // k-means++ seeding: fixed, so training is reproducible
+};
+
+// Builds templates as cluster means of labelled frames (k-means per class on LPC spectra, the
+// viseme clusters of paper 001 section 4 applied to spectra) and per-bin distance weights from
+// the pooled within-class variance.
+class TemplateTrainer {
+public:
+    TemplateTrainer(const TrainingOptions& options, const PhonemeSet& set);
+    // Frames of one utterance with its reference labels (common-set names).
+    void addUtterance(std::span<const FrameFeatures> frames, const PhonemeSchedule& labels);
+    // Frames of a sustained sound of one class (calibration recordings).
+    void addSustained(std::span<const FrameFeatures> frames, const std::string& phoneme);
+    std::size_t frames(const std::string& phoneme) const;
+    // Throws InputError when no class has enough frames.
+    TemplateSet build(const std::string& description) const;
+
+private:
+    void addFrame(const FrameFeatures& frame, std::size_t phoneme);
+    TrainingOptions options_;
+    const PhonemeSet* set_;
+    std::vector<std::vector<std::vector<float>>> spectra_;  // [class][frame][bin]
+};
+
+// Frame-by-frame agreement of a schedule with reference labels, sampled every `step` seconds.
+struct ScheduleScore {
+    std::size_t frames = 0, correct = 0, groupCorrect = 0;
+    std::vector<std::vector<std::size_t>> confusion;  // [reference][hypothesis], set indices
+
+    double accuracy() const { return frames ? static_cast<double>(correct) / frames : 0.0; }
+    double groupAccuracy() const { return frames ? static_cast<double>(groupCorrect) / frames : 0.0; }
+    void add(const ScheduleScore& other);
+};
+ScheduleScore scoreSchedule(const PhonemeSchedule& hypothesis, const PhonemeSchedule& reference,
+                            const PhonemeSet& set, double step = 0.01);
 
 AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet& templates,
                            const PhonemeSet& set, const FrontEndConfig& config = {},

@@ -1,0 +1,79 @@
+// lipsync analyze: audio to a phoneme schedule by the LPC front end.
+#include "Commands.hpp"
+#include "FrontEndOptions.hpp"
+#include "Output.hpp"
+
+#include <lipsyncd/core.hpp>
+#include <lipsyncd/dsp.hpp>
+
+#include <iomanip>
+#include <iostream>
+
+namespace lipsyncd::cli {
+
+namespace {
+struct AnalyzeOptions {
+    std::string input;
+    std::string schedule;
+    std::string format = "tsv";
+    std::string frames;
+    FrontEndOptions frontEnd;
+    bool quiet = false;
+};
+
+void writeFrames(std::ostream& out, const dsp::AnalysisResult& result, const PhonemeSet& set) {
+    out << "time,energy_db,noise_floor_db,normalized_error,voiced,silent,class,confidence,"
+           "runner_up,distance,runner_up_distance\n"
+        << std::fixed;
+    for (const auto& f : result.frames) {
+        const auto& l = f.label;
+        out << std::setprecision(3) << l.time << ',' << std::setprecision(1) << l.energyDb << ','
+            << l.noiseFloorDb << ',' << std::setprecision(4) << f.features.normalizedError << ','
+            << l.voiced << ',' << l.silent << ',' << set[l.phoneme].name << ','
+            << std::setprecision(3) << l.confidence << ',' << set[l.runnerUp].name << ','
+            << l.distance << ',' << l.runnerUpDistance << '\n';
+    }
+}
+
+void runAnalyze(const AnalyzeOptions& o) {
+    const auto templates = o.frontEnd.loadTemplates();
+    const auto& set = PhonemeSet::common();
+    const auto result = dsp::analyzeFile(o.input, templates, set, o.frontEnd.config(),
+                                         o.frontEnd.decode(), o.frontEnd.raw(), !o.frames.empty());
+    if (result.nonFiniteSamples > 0)
+        std::cerr << "lipsync analyze: warning: " << o.input << ": " << result.nonFiniteSamples
+                  << " non-finite samples (NaN/inf) read as silence\n";
+    if (!o.quiet)
+        std::cerr << "lipsync analyze: " << o.input << ": " << std::fixed << std::setprecision(2)
+                  << result.durationSeconds << " s at " << result.inputRate << " Hz, "
+                  << result.schedule.size() << " segments (resampler delay "
+                  << std::setprecision(1) << result.resamplerDelaySeconds * 1000 << " ms)\n";
+    withOutputStream(o.schedule, [&](std::ostream& out) {
+        if (o.format == "json")
+            writeScheduleJson(out, result.schedule);
+        else
+            writeSchedule(out, result.schedule);
+    });
+    if (!o.frames.empty())
+        withOutputStream(o.frames, [&](std::ostream& out) { writeFrames(out, result, set); });
+}
+}  // namespace
+
+void addAnalyzeCommand(CLI::App& app) {
+    auto o = std::make_shared<AnalyzeOptions>();
+    auto* cmd = app.add_subcommand(
+        "analyze", "Analyse speech audio into a timed phoneme schedule (linear prediction)");
+    cmd->add_option("input", o->input, "Audio file (WAV, FLAC, OGG; '-' for stdin)")->required();
+    cmd->add_option("--schedule,-s", o->schedule, "Write the schedule here ('-' for stdout)")
+        ->required();
+    cmd->add_option("--format", o->format, "Schedule format")
+        ->check(CLI::IsMember({"tsv", "json"}))
+        ->capture_default_str();
+    cmd->add_option("--frames", o->frames,
+                    "Also write per-frame energy, voicing, class, runner-up and distances (CSV)");
+    cmd->add_flag("--quiet,-q", o->quiet, "No summary on stderr");
+    o->frontEnd.addTo(*cmd);
+    cmd->callback([o] { runAnalyze(*o); });
+}
+
+}  // namespace lipsyncd::cli

@@ -1,0 +1,86 @@
+// lipsync calibrate: a speaker's own templates from a few sustained sounds (aa.wav, ih.wav,
+// bmp.wav, ...), on top of a base set for the classes not recorded.
+#include "Commands.hpp"
+
+#include <lipsyncd/dsp.hpp>
+
+#include <algorithm>
+#include <iostream>
+
+namespace lipsyncd::cli {
+
+namespace {
+struct CalibrateOptions {
+    std::string folder;
+    std::string output;
+    std::string base;
+    int clusters = 2;
+};
+
+// "aa.wav", "aa-2.wav", "aa_take3.wav" all belong to class "aa".
+std::string classOfFile(const std::filesystem::path& file) {
+    const auto stem = file.stem().string();
+    return stem.substr(0, stem.find_first_of("-_."));
+}
+
+void runCalibrate(const CalibrateOptions& o) {
+    const auto& set = PhonemeSet::common();
+    auto base = o.base.empty() ? dsp::TemplateSet::loadDefault()
+                               : dsp::TemplateSet::load(findDataFile(o.base));
+    dsp::TrainingOptions training;
+    training.analysis = base.analysis;
+    training.clustersPerClass = o.clusters;
+    training.minFramesPerCluster = 10;  // a second of held sound is plenty for one speaker
+    dsp::TemplateTrainer trainer(training, set);
+    std::vector<std::string> recorded;
+    if (!std::filesystem::is_directory(o.folder)) throw InputError(o.folder + ": not a folder");
+    for (const auto& entry : std::filesystem::directory_iterator(o.folder)) {
+        const auto ext = entry.path().extension().string();
+        if (ext != ".wav" && ext != ".flac" && ext != ".ogg") continue;
+        const auto cls = classOfFile(entry.path());
+        if (!set.find(cls)) {
+            std::cerr << "lipsync calibrate: skipped " << entry.path().string() << ": '" << cls
+                      << "' is not a phoneme class (name files after a class: aa.wav, bmp.wav...)\n";
+            continue;
+        }
+        trainer.addSustained(dsp::analyzeFrames(entry.path(), training.analysis), cls);
+        if (std::find(recorded.begin(), recorded.end(), cls) == recorded.end()) recorded.push_back(cls);
+    }
+    if (recorded.empty()) throw InputError(o.folder + ": no recordings named after a phoneme class");
+    const auto own = trainer.build("calibration");
+    for (const auto& cls : own.classes) {
+        auto it = std::find_if(base.classes.begin(), base.classes.end(),
+                               [&](const auto& c) { return c.phoneme == cls.phoneme; });
+        if (it != base.classes.end())
+            *it = cls;
+        else
+            base.classes.push_back(cls);
+        std::cerr << "lipsync calibrate: " << cls.phoneme << ": " << cls.frames << " frames, "
+                  << cls.spectra.size() << " template(s)\n";
+    }
+    for (const auto& cls : recorded)
+        if (trainer.frames(cls) < training.minFramesPerCluster)
+            std::cerr << "lipsync calibrate: warning: " << cls
+                      << ": too little steady sound; kept the base templates\n";
+    base.description = "calibrated from " + o.folder + " over " +
+                       (o.base.empty() ? std::string("the default set") : o.base);
+    base.save(o.output);
+    std::cerr << "lipsync calibrate: wrote " << o.output << '\n';
+}
+}  // namespace
+
+void addCalibrateCommand(CLI::App& app) {
+    auto o = std::make_shared<CalibrateOptions>();
+    auto* cmd = app.add_subcommand(
+        "calibrate",
+        "Build a speaker's templates from recordings of sustained sounds named after their class "
+        "(aa.wav, ih.wav, w.wav, bmp.wav, ...)");
+    cmd->add_option("folder", o->folder, "Folder of recordings")->required();
+    cmd->add_option("-o,--output", o->output, "Template file to write (JSON)")->required();
+    cmd->add_option("--base", o->base, "Templates for the classes not recorded (default: shipped set)");
+    cmd->add_option("--clusters", o->clusters, "Cluster means per recorded class")
+        ->check(CLI::Range(1, 8))->capture_default_str();
+    cmd->callback([o] { runCalibrate(*o); });
+}
+
+}  // namespace lipsyncd::cli

@@ -1,0 +1,53 @@
+#include "Corpus.hpp"
+
+#include <algorithm>
+#include <iostream>
+
+namespace lipsyncd::cli {
+
+namespace fs = std::filesystem;
+
+std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>* skipped) {
+    if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder");
+    std::vector<CorpusItem> items;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        if (entry.path().extension() != ".wav") continue;
+        auto lab = entry.path();
+        lab.replace_extension(".lab");
+        if (!fs::exists(lab)) {
+            if (skipped) skipped->push_back(entry.path().string() + ": no " + lab.filename().string());
+            continue;
+        }
+        items.push_back({entry.path().stem().string(), entry.path(), lab});
+    }
+    std::sort(items.begin(), items.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+    if (items.empty()) throw InputError(dir.string() + ": no NAME.wav + NAME.lab pairs");
+    return items;
+}
+
+PhonemeSchedule readLabels(const fs::path& file, const std::string& alphabet) {
+    std::vector<std::string> warnings;
+    PhonemeSchedule labels;
+    if (alphabet == "auto") {
+        ScheduleReadOptions strict;
+        strict.unknownIsError = true;
+        try {
+            return readScheduleFile(file, strict);
+        } catch (const InputError&) {
+            // Not all common-set names: ARPAbet is the other alphabet labels come in.
+        }
+        return readLabels(file, "arpabet");
+    }
+    if (alphabet == "common") {
+        labels = readScheduleFile(file, {}, &warnings);
+    } else {
+        const auto map = PhonemeMap::named(alphabet);
+        ScheduleReadOptions options;
+        options.map = &map;
+        labels = readScheduleFile(file, options, &warnings);
+    }
+    for (const auto& w : warnings) std::cerr << "lipsync: warning: " << w << '\n';
+    return labels;
+}
+
+}  // namespace lipsyncd::cli

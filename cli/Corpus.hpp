@@ -1,0 +1,28 @@
+// A labelled corpus: NAME.wav beside NAME.lab in one folder (DESIGN.md: reference labels are
+// `start end phoneme`, ARPAbet in any case with stress digits, or common-set names).
+#pragma once
+
+#include <lipsyncd/core.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace lipsyncd::cli {
+
+struct CorpusItem {
+    std::string name;
+    std::filesystem::path audio;
+    std::filesystem::path labels;
+};
+
+// Every NAME.wav with a NAME.lab, sorted by name. Throws InputError for a missing folder or
+// one with no pairs; audio without labels is reported in `skipped`.
+std::vector<CorpusItem> listCorpus(const std::filesystem::path& dir,
+                                   std::vector<std::string>* skipped = nullptr);
+
+// Reads labels in `alphabet`: "common", "arpabet", a map name or file, or "auto" (common-set
+// names if every symbol is one, else ARPAbet).
+PhonemeSchedule readLabels(const std::filesystem::path& file, const std::string& alphabet);
+
+}  // namespace lipsyncd::cli

@@ -1,0 +1,51 @@
+// Options every command that runs the front end shares: templates, channel, raw input.
+#pragma once
+
+#include <lipsyncd/dsp.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <optional>
+#include <string>
+
+namespace lipsyncd::cli {
+
+struct FrontEndOptions {
+    std::string templates;  // empty: the shipped default
+    int channel = -1;
+    std::string rawSpec;
+    std::string resampler = "medium";
+
+    void addTo(CLI::App& cmd) {
+        cmd.add_option("--templates", templates,
+                       "Template set (JSON; default: config/templates/default.json)");
+        cmd.add_option("--channel", channel,
+                       "Analyse only this channel (0-based) instead of the mono mix")
+            ->check(CLI::Range(0, 63));
+        cmd.add_option("--raw", rawSpec,
+                       "Input is headerless PCM: RATE:FORMAT:CHANNELS, e.g. 16000:s16:1 "
+                       "(formats s8 u8 s16 s24 s32 f32 f64, little-endian)");
+        cmd.add_option("--resampler", resampler, "Resampler quality")
+            ->check(CLI::IsMember({"low", "medium", "high", "veryhigh"}))
+            ->capture_default_str();
+    }
+
+    dsp::TemplateSet loadTemplates() const {
+        return templates.empty() ? dsp::TemplateSet::loadDefault()
+                                 : dsp::TemplateSet::load(findDataFile(templates));
+    }
+    dsp::DecodeOptions decode() const { return {channel}; }
+    std::optional<dsp::RawFormat> raw() const {
+        if (rawSpec.empty()) return std::nullopt;
+        return dsp::RawFormat::parse(rawSpec);
+    }
+    dsp::FrontEndConfig config() const {
+        dsp::FrontEndConfig c;
+        if (resampler == "low") c.resamplerQuality = dsp::ResamplerQuality::Low;
+        if (resampler == "high") c.resamplerQuality = dsp::ResamplerQuality::High;
+        if (resampler == "veryhigh") c.resamplerQuality = dsp::ResamplerQuality::VeryHigh;
+        return c;
+    }
+};
+
+}  // namespace lipsyncd::cli

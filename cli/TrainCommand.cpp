@@ -1,0 +1,71 @@
+// lipsync train: spectral templates from labelled audio (cluster means per class).
+#include "Commands.hpp"
+#include "Corpus.hpp"
+
+#include <lipsyncd/dsp.hpp>
+
+#include <iomanip>
+#include <iostream>
+
+namespace lipsyncd::cli {
+
+namespace {
+struct TrainOptions {
+    std::vector<std::string> corpora;
+    std::string output;
+    std::string labels = "auto";
+    dsp::TrainingOptions training;
+    std::string description;
+};
+
+void runTrain(const TrainOptions& o) {
+    const auto& set = PhonemeSet::common();
+    dsp::TemplateTrainer trainer(o.training, set);
+    std::size_t files = 0;
+    double seconds = 0;
+    for (const auto& dir : o.corpora) {
+        std::vector<std::string> skipped;
+        const auto items = listCorpus(dir, &skipped);
+        for (const auto& s : skipped) std::cerr << "lipsync train: skipped " << s << '\n';
+        for (const auto& item : items) {
+            const auto labels = readLabels(item.labels, o.labels);
+            const auto frames = dsp::analyzeFrames(item.audio, o.training.analysis);
+            trainer.addUtterance(frames, labels);
+            seconds += frames.size() * o.training.analysis.hopSeconds;
+            if (++files % 50 == 0)
+                std::cerr << "lipsync train: " << files << " files, " << std::fixed
+                          << std::setprecision(0) << seconds << " s of audio\n";
+        }
+    }
+    auto templates = trainer.build(o.description.empty()
+                                       ? "trained by 'lipsync train' from " + std::to_string(files) + " files"
+                                       : o.description);
+    templates.save(o.output);
+    std::cerr << "lipsync train: " << files << " files (" << std::fixed << std::setprecision(0)
+              << seconds << " s) -> " << templates.classes.size() << " classes in " << o.output << '\n';
+    for (const auto& c : set.classes())
+        if (trainer.frames(c.name) < o.training.minFramesPerCluster && c.name != "sil")
+            std::cerr << "lipsync train: note: class '" << c.name << "' has only "
+                      << trainer.frames(c.name) << " frames: no template\n";
+}
+}  // namespace
+
+void addTrainCommand(CLI::App& app) {
+    auto o = std::make_shared<TrainOptions>();
+    auto* cmd = app.add_subcommand(
+        "train", "Train spectral templates from labelled audio (NAME.wav + NAME.lab folders)");
+    cmd->add_option("corpus", o->corpora, "Folders of NAME.wav + NAME.lab")->required()->check(CLI::ExistingDirectory);
+    cmd->add_option("-o,--output", o->output, "Template file to write (JSON)")->required();
+    cmd->add_option("--labels", o->labels, "Label alphabet: auto, common, arpabet, or a map name/file")
+        ->capture_default_str();
+    cmd->add_option("--clusters", o->training.clustersPerClass, "Cluster means per class")
+        ->check(CLI::Range(1, 16))->capture_default_str();
+    cmd->add_option("--order", o->training.analysis.order, "LPC order")
+        ->check(CLI::Range(2, dsp::kMaxOrder))->capture_default_str();
+    cmd->add_option("--bins", o->training.analysis.spectrumBins, "Spectrum points 0..rate/2")
+        ->check(CLI::Range(4, 512))->capture_default_str();
+    cmd->add_option("--description", o->description, "Description stored in the file");
+    cmd->callback([o] { runTrain(*o); });
+}
+
+}  // namespace lipsyncd::cli

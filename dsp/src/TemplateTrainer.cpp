@@ -1,0 +1,149 @@
+// Template training: cluster means per class (paper 001, section 4, applied to LPC spectra).
+#include <lipsyncd/dsp.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+
+namespace lipsyncd::dsp {
+
+namespace {
+using Spectrum = std::vector<float>;
+
+float squaredDistance(const Spectrum& a, const Spectrum& b) {
+    float acc = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) acc += (a[i] - b[i]) * (a[i] - b[i]);
+    return acc;
+}
+
+Spectrum mean(const std::vector<const Spectrum*>& members, std::size_t bins) {
+    Spectrum m(bins, 0.0f);
+    for (const auto* s : members)
+        for (std::size_t b = 0; b < bins; ++b) m[b] += (*s)[b];
+    for (auto& v : m) v /= static_cast<float>(std::max<std::size_t>(1, members.size()));
+    return m;
+}
+
+// k-means with k-means++ seeding from a fixed seed: the same frames give the same templates.
+std::vector<Spectrum> kMeans(const std::vector<Spectrum>& points, int k, std::uint32_t seed) {
+    const std::size_t bins = points.front().size();
+    std::mt19937 rng(seed);
+    std::vector<Spectrum> centres{points[std::uniform_int_distribution<std::size_t>(0, points.size() - 1)(rng)]};
+    std::vector<float> nearest(points.size());
+    while (static_cast<int>(centres.size()) < k) {
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            nearest[i] = std::numeric_limits<float>::max();
+            for (const auto& c : centres) nearest[i] = std::min(nearest[i], squaredDistance(points[i], c));
+        }
+        std::discrete_distribution<std::size_t> pick(nearest.begin(), nearest.end());
+        centres.push_back(points[pick(rng)]);
+    }
+    std::vector<int> assignment(points.size(), -1);
+    for (int iteration = 0; iteration < 30; ++iteration) {
+        bool changed = false;
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            int best = 0;
+            for (int c = 1; c < k; ++c)
+                if (squaredDistance(points[i], centres[c]) < squaredDistance(points[i], centres[best])) best = c;
+            changed |= assignment[i] != best;
+            assignment[i] = best;
+        }
+        if (!changed) break;
+        for (int c = 0; c < k; ++c) {
+            std::vector<const Spectrum*> members;
+            for (std::size_t i = 0; i < points.size(); ++i)
+                if (assignment[i] == c) members.push_back(&points[i]);
+            if (!members.empty()) centres[c] = mean(members, bins);
+        }
+    }
+    return centres;
+}
+}  // namespace
+
+TemplateTrainer::TemplateTrainer(const TrainingOptions& options, const PhonemeSet& set)
+    : options_(options), set_(&set), spectra_(set.size()) {
+    options_.analysis.validate();
+}
+
+void TemplateTrainer::addFrame(const FrameFeatures& frame, std::size_t phoneme) {
+    spectra_[phoneme].push_back(frame.spectrum);
+}
+
+void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames, const PhonemeSchedule& labels) {
+    float peak = -120;
+    for (const auto& f : frames) peak = std::max(peak, f.energyDb);
+    std::size_t seg = 0;
+    for (const auto& f : frames) {
+        while (seg < labels.size() && labels[seg].end <= f.time) ++seg;
+        if (seg >= labels.size()) break;
+        const auto& label = labels[seg];
+        if (f.time < label.start) continue;
+        const double margin = options_.boundaryMarginSeconds;
+        // Transitions belong to neither neighbour; keep frames well inside a segment (short
+        // segments keep their middle frame).
+        const bool inside = f.time - label.start >= margin && label.end - f.time >= margin;
+        const bool middle = std::abs(f.time - 0.5 * (label.start + label.end)) <= 0.5 * options_.analysis.hopSeconds;
+        if (!inside && !middle) continue;
+        if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb) continue;
+        if (const auto cls = set_->find(label.phoneme)) addFrame(f, *cls);
+    }
+}
+
+void TemplateTrainer::addSustained(std::span<const FrameFeatures> frames, const std::string& phoneme) {
+    const auto cls = set_->find(phoneme);
+    if (!cls) throw InputError("'" + phoneme + "' is not a phoneme class");
+    float peak = -120;
+    for (const auto& f : frames) peak = std::max(peak, f.energyDb);
+    for (const auto& f : frames)
+        if (f.valid && f.energyDb >= peak - 20) addFrame(f, *cls);  // the held part, not the fades
+}
+
+std::size_t TemplateTrainer::frames(const std::string& phoneme) const {
+    const auto cls = set_->find(phoneme);
+    return cls ? spectra_[*cls].size() : 0;
+}
+
+TemplateSet TemplateTrainer::build(const std::string& description) const {
+    TemplateSet t;
+    t.analysis = options_.analysis;
+    t.description = description;
+    const auto bins = static_cast<std::size_t>(options_.analysis.spectrumBins);
+    // Pooled within-class variance per bin: bins where classes differ more than frames of one
+    // class scatter get more weight (inverse variance; notes/dsp.md, Tohkura 1987).
+    std::vector<double> variance(bins, 0.0);
+    std::size_t pooled = 0;
+    for (std::size_t c = 0; c < spectra_.size(); ++c) {
+        const auto& frames = spectra_[c];
+        if (frames.size() < options_.minFramesPerCluster) continue;
+        std::vector<const Spectrum*> all;
+        for (const auto& f : frames) all.push_back(&f);
+        const auto m = mean(all, bins);
+        for (const auto& f : frames)
+            for (std::size_t b = 0; b < bins; ++b) variance[b] += (f[b] - m[b]) * (f[b] - m[b]);
+        pooled += frames.size();
+
+        TemplateSet::ClassTemplates cls;
+        cls.phoneme = (*set_)[c].name;
+        cls.frames = frames.size();
+        const int k = static_cast<int>(std::clamp<std::size_t>(
+            frames.size() / options_.minFramesPerCluster, 1, static_cast<std::size_t>(options_.clustersPerClass)));
+        cls.spectra = kMeans(frames, k, options_.seed + static_cast<std::uint32_t>(c));
+        t.classes.push_back(std::move(cls));
+    }
+    if (t.classes.empty())
+        throw InputError("training: no class has " + std::to_string(options_.minFramesPerCluster) +
+                         " usable frames; give more (or longer) labelled audio");
+    t.binWeights.resize(bins);
+    double sum = 0;
+    for (std::size_t b = 0; b < bins; ++b) {
+        const double v = variance[b] / static_cast<double>(std::max<std::size_t>(1, pooled));
+        t.binWeights[b] = static_cast<float>(1.0 / std::max(v, 1.0));  // ≥ 1 dB² floor
+        sum += t.binWeights[b];
+    }
+    for (auto& w : t.binWeights) w = static_cast<float>(w * bins / sum);  // mean weight 1
+    return t;
+}
+
+}  // namespace lipsyncd::dsp

@@ -1,0 +1,75 @@
+#include <lipsyncd/dsp.hpp>
+
+#include "../../dsp/src/LpcSpectrum.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace lipsyncd::dsp;
+
+namespace {
+std::vector<float> sine(double hz, int rate, int n, float amplitude = 0.5f) {
+    std::vector<float> x(n);
+    for (int i = 0; i < n; ++i) x[i] = amplitude * static_cast<float>(std::sin(2 * M_PI * hz * i / rate));
+    return x;
+}
+}  // namespace
+
+TEST(FrameAnalyzer, SpectrumPeaksAtAToneFrequency) {
+    AnalysisConfig c;
+    FrameAnalyzer analyzer(c);
+    auto f = analyzer.makeFeatures();
+    std::mt19937 rng(1);
+    std::normal_distribution<float> noise(0, 0.01f);
+    auto x = sine(1500, c.analysisRate, c.windowSamples());
+    for (auto& v : x) v += noise(rng);
+    analyzer.analyze(x, f);
+    ASSERT_TRUE(f.valid);
+    const auto peak = std::max_element(f.spectrum.begin(), f.spectrum.end()) - f.spectrum.begin();
+    const double peakHz = 5000.0 * peak / c.spectrumBins;
+    EXPECT_NEAR(peakHz, 1500, 5000.0 / c.spectrumBins);
+    EXPECT_NEAR(f.energyDb, 20 * std::log10(0.5 / std::sqrt(2.0)), 0.5);
+}
+
+TEST(FrameAnalyzer, SilenceAndClippingAreMarkedNotCrashed) {
+    AnalysisConfig c;
+    FrameAnalyzer analyzer(c);
+    auto f = analyzer.makeFeatures();
+    const std::vector<float> silence(c.windowSamples(), 0.0f);
+    analyzer.analyze(silence, f);
+    EXPECT_FALSE(f.valid);
+    for (float v : f.spectrum) EXPECT_EQ(v, 0.0f);
+    auto square = sine(200, c.analysisRate, c.windowSamples(), 4.0f);
+    for (auto& v : square) v = std::clamp(v, -1.0f, 1.0f);
+    analyzer.analyze(square, f);
+    EXPECT_TRUE(f.clipped);
+    for (float v : f.spectrum) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(LpcSpectrum, DirectAndFftEvaluationAgree) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+    DirectLpcSpectrum direct(12, 32);
+    FftLpcSpectrum fft(32);
+    std::vector<float> a(13), d(32), f(32);
+    for (int trial = 0; trial < 10; ++trial) {
+        a[0] = 1;
+        for (int i = 1; i < 13; ++i) a[i] = u(rng) / i;
+        direct.evaluate(a, d);
+        fft.evaluate(a, f);
+        for (int m = 0; m < 32; ++m) EXPECT_NEAR(d[m], f[m], 1e-3) << m;
+    }
+}
+
+TEST(AnalysisConfig, RejectsNonsenseNamingTheField) {
+    AnalysisConfig c;
+    c.order = 40;
+    try {
+        c.validate();
+        FAIL();
+    } catch (const lipsyncd::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("analysis.order"), std::string::npos);
+    }
+}

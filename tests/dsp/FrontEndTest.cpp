@@ -1,0 +1,191 @@
+// The whole front end: formats, rates and channels give the same schedule; streaming equals one
+// block; bad input is refused clearly or read correctly.
+#include "TestSpeech.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sys/resource.h>
+
+using namespace lipsyncd;
+
+namespace {
+const dsp::TemplateSet& templates() {
+    static const auto t = dsp::TemplateSet::loadDefault();
+    return t;
+}
+
+dsp::AnalysisResult analyze(const std::filesystem::path& file, dsp::DecodeOptions decode = {}) {
+    return dsp::analyzeFile(file, templates(), PhonemeSet::common(), {}, decode);
+}
+
+std::string errorOf(const std::filesystem::path& file) {
+    try {
+        analyze(file);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+std::filesystem::path writeBytes(const std::string& name, const std::string& bytes) {
+    const auto path = std::filesystem::temp_directory_path() / ("lipsyncd_test_" + name);
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+}
+
+// Share of 10 ms frames on which two schedules agree.
+double agreement(const PhonemeSchedule& a, const PhonemeSchedule& b) {
+    return dsp::scoreSchedule(a, b, PhonemeSet::common()).accuracy();
+}
+}  // namespace
+
+TEST(FrontEnd, SameSpeechInAnyFormatRateOrLayoutGivesTheSameSchedule) {
+    const auto& speech = test::testSpeech();
+    const auto reference = analyze(test::writeAudio("ref.wav", speech.samples, speech.rate,
+                                                    SF_FORMAT_WAV | SF_FORMAT_FLOAT));
+    ASSERT_GT(reference.schedule.size(), 10u);
+    struct Variant {
+        const char* name;
+        int rate;
+        int format;
+        std::vector<float> gains;
+        int channel;
+    };
+    const std::vector<Variant> variants = {
+        {"s16_16k.wav", 16000, SF_FORMAT_WAV | SF_FORMAT_PCM_16, {1.0f}, -1},
+        {"s24_44k.wav", 44100, SF_FORMAT_WAV | SF_FORMAT_PCM_24, {1.0f}, -1},
+        {"f32_48k.wav", 48000, SF_FORMAT_WAV | SF_FORMAT_FLOAT, {1.0f}, -1},
+        {"s32_48k.wav", 48000, SF_FORMAT_WAV | SF_FORMAT_PCM_32, {1.0f}, -1},
+        {"stereo_mix.wav", 44100, SF_FORMAT_WAV | SF_FORMAT_PCM_16, {0.7f, 0.7f}, -1},
+        {"stereo_ch1.wav", 48000, SF_FORMAT_WAV | SF_FORMAT_PCM_16, {0.0f, 1.0f}, 1},
+        {"flac_16k.flac", 16000, SF_FORMAT_FLAC | SF_FORMAT_PCM_16, {1.0f}, -1},
+    };
+    for (const auto& v : variants) {
+        const auto audio = test::resampleOffline(speech.samples, speech.rate, v.rate);
+        const auto file = test::writeAudio(v.name, audio, v.rate, v.format, v.gains);
+        const auto result = analyze(file, {v.channel});
+        EXPECT_EQ(result.inputRate, v.rate);
+        EXPECT_NEAR(result.durationSeconds, reference.durationSeconds, 0.01) << v.name;
+        EXPECT_GT(agreement(result.schedule, reference.schedule), 0.9) << v.name;
+    }
+}
+
+TEST(FrontEnd, ChannelSelectionIgnoresTheOtherChannel) {
+    // Voice on the left, a loud control tone on the right (as show files have it).
+    const auto& speech = test::testSpeech();
+    const auto file = test::writeAudio("show.wav", speech.samples, speech.rate,
+                                       SF_FORMAT_WAV | SF_FORMAT_FLOAT, {1.0f, 1.0f});
+    const auto voiceOnly = test::writeAudio("voice.wav", speech.samples, speech.rate,
+                                            SF_FORMAT_WAV | SF_FORMAT_FLOAT);
+    EXPECT_EQ(analyze(file, {0}).schedule, analyze(voiceOnly).schedule);
+    try {
+        analyze(file, {2});
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--channel 2 does not exist"), std::string::npos) << e.what();
+    }
+}
+
+TEST(FrontEnd, StreamingInOddChunksGivesTheSameFramesAsOneBlock) {
+    const auto& speech = test::testSpeech();
+    dsp::AnalysisConfig config;
+    auto run = [&](std::size_t chunk) {
+        dsp::FrameStream stream(config, speech.rate);
+        std::vector<dsp::FrameFeatures> frames;
+        const dsp::FrameStream::Sink keep = [&](const dsp::FrameFeatures& f) { frames.push_back(f); };
+        for (std::size_t i = 0; i < speech.samples.size(); i += chunk)
+            stream.push(std::span<const float>(speech.samples).subspan(i, std::min(chunk, speech.samples.size() - i)), keep);
+        stream.finish(keep);
+        return frames;
+    };
+    const auto whole = run(speech.samples.size());
+    for (std::size_t chunk : {1u, 7u, 160u, 333u, 4097u}) {
+        const auto parts = run(chunk);
+        ASSERT_EQ(parts.size(), whole.size()) << "chunk " << chunk;
+        for (std::size_t i = 0; i < whole.size(); ++i) {
+            ASSERT_DOUBLE_EQ(parts[i].time, whole[i].time);
+            ASSERT_NEAR(parts[i].energyDb, whole[i].energyDb, 1e-3) << "chunk " << chunk << " frame " << i;
+            for (std::size_t b = 0; b < whole[i].spectrum.size(); ++b)
+                ASSERT_NEAR(parts[i].spectrum[b], whole[i].spectrum[b], 1e-2) << "chunk " << chunk << " frame " << i;
+        }
+    }
+}
+
+TEST(FrontEnd, SegmentsCloseWithinTheReportedLatency) {
+    const auto& speech = test::testSpeech();
+    dsp::StreamingAnalyzer analyzer(templates(), PhonemeSet::common(), speech.rate);
+    double pushedSeconds = 0, worstLag = 0;
+    int segments = 0;
+    analyzer.onSegment([&](const PhonemeSegment& s) {
+        worstLag = std::max(worstLag, pushedSeconds - s.end);
+        ++segments;
+    });
+    const std::size_t block = speech.rate / 100;  // 10 ms
+    for (std::size_t i = 0; i < speech.samples.size(); i += block) {
+        const auto n = std::min(block, speech.samples.size() - i);
+        analyzer.push(std::span<const float>(speech.samples).subspan(i, n));
+        pushedSeconds += static_cast<double>(n) / speech.rate;
+    }
+    EXPECT_GT(segments, 5);
+    EXPECT_LE(worstLag, analyzer.latencySeconds() + 0.011);
+    EXPECT_LT(analyzer.latencySeconds(), 0.2);
+}
+
+TEST(FrontEnd, BadFilesGetClearErrors) {
+    EXPECT_NE(errorOf("/nonexistent/x.wav").find("no such file"), std::string::npos);
+    EXPECT_NE(errorOf(writeBytes("empty.wav", "")).find("cannot decode"), std::string::npos);
+    EXPECT_NE(errorOf(writeBytes("junk.wav", std::string(5000, 'x'))).find("cannot decode"), std::string::npos);
+    EXPECT_NE(errorOf(writeBytes("trunc.wav", "RIFF\x24\x00\x00\x00WAVEfmt ")).find("lipsyncd_test_trunc.wav"),
+              std::string::npos);
+    EXPECT_NE(errorOf(std::filesystem::temp_directory_path()).find("is a directory"), std::string::npos);
+}
+
+TEST(FrontEnd, ZeroLengthAudioGivesAnEmptySchedule) {
+    const auto file = test::writeAudio("zero.wav", {}, 16000, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+    const auto result = analyze(file);
+    EXPECT_EQ(result.durationSeconds, 0.0);
+    EXPECT_LE(result.schedule.size(), 1u);
+}
+
+TEST(FrontEnd, TruncatedDataIsReadAsFarAsItGoes) {
+    const auto& speech = test::testSpeech();
+    const auto file = test::writeAudio("cut.wav", speech.samples, speech.rate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+    std::filesystem::resize_file(file, std::filesystem::file_size(file) / 2);
+    const auto result = analyze(file);
+    EXPECT_NEAR(result.durationSeconds, speech.samples.size() / 2.0 / speech.rate, 0.01);
+    EXPECT_FALSE(result.schedule.empty());
+}
+
+TEST(FrontEnd, NaNSamplesAreCountedAndReadAsSilence) {
+    auto samples = test::testSpeech().samples;
+    for (std::size_t i = 1000; i < 3000; ++i) samples[i] = std::nanf("");
+    samples[5000] = INFINITY;
+    const auto file = test::writeAudio("nan.wav", samples, test::testSpeech().rate, SF_FORMAT_WAV | SF_FORMAT_FLOAT);
+    const auto result = analyze(file);
+    EXPECT_EQ(result.nonFiniteSamples, 2001);
+    for (const auto& s : result.schedule) {
+        EXPECT_TRUE(std::isfinite(s.start) && std::isfinite(s.end));
+        EXPECT_TRUE(std::isfinite(s.confidence));
+    }
+}
+
+TEST(FrontEnd, TenHoursOfSilenceStreamInBoundedMemory) {
+    // 10 h at 8 kHz, pushed as a live stream would push it; memory must not grow with length.
+    dsp::StreamingAnalyzer analyzer(templates(), PhonemeSet::common(), 8000);
+    std::size_t segments = 0;
+    analyzer.onSegment([&](const PhonemeSegment&) { ++segments; });
+    const std::vector<float> block(8000, 0.0f);
+    auto maxRssKb = [] {
+        rusage u{};
+        getrusage(RUSAGE_SELF, &u);
+        return u.ru_maxrss;
+    };
+    for (int s = 0; s < 60; ++s) analyzer.push(block);  // warm up
+    const long before = maxRssKb();
+    for (int s = 0; s < 10 * 3600; ++s) analyzer.push(block);
+    analyzer.finish();
+    EXPECT_LT(maxRssKb() - before, 4096) << "peak memory grew by more than 4 MiB";
+    EXPECT_EQ(segments, 1u);  // one long silence
+}
