@@ -87,6 +87,8 @@ std::span<const PhonemeSegment> Segmenter::push(const FrameLabel& label) {
         run.end = end;
         run.confidenceSum += label.confidence;
         ++run.frames;
+        // The run before may now be final: this one has just reached its minimum.
+        if (pending_.size() >= 2) settle(false);
     } else {
         const double runStart = pending_.empty() ? (emittedUntil_ > 0 ? emittedUntil_ : start)
                                                  : pending_.back().end;

@@ -4,6 +4,7 @@
 
 #include <soxr.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace lipsyncd::dsp {
@@ -18,6 +19,27 @@ struct StreamResampler::State {
 };
 
 namespace {
+soxr_t createSoxr(double inputRate, double outputRate, ResamplerQuality quality);
+
+// Feeds silence in 10 ms blocks through a fresh resampler and returns the most input time it
+// held back; run once at setup, so process() stays allocation-free.
+double measureHeldBack(double inputRate, double outputRate, ResamplerQuality quality) {
+    soxr_t probe = createSoxr(inputRate, outputRate, quality);
+    const auto block = static_cast<std::size_t>(std::max(1.0, std::round(inputRate / 100)));
+    std::vector<float> in(block, 0.0f);
+    std::vector<float> out(static_cast<std::size_t>(std::ceil(block * outputRate / inputRate)) + 4096);
+    double fed = 0, made = 0, worst = 0;
+    for (int i = 0; i < 100; ++i) {
+        size_t used = 0, produced = 0;
+        soxr_process(probe, in.data(), in.size(), &used, out.data(), out.size(), &produced);
+        fed += static_cast<double>(used) / inputRate;
+        made += static_cast<double>(produced) / outputRate;
+        worst = std::max(worst, fed - made);
+    }
+    soxr_delete(probe);
+    return worst;
+}
+
 unsigned long soxrRecipe(ResamplerQuality q) {
     switch (q) {
         case ResamplerQuality::Low: return SOXR_LQ;
@@ -27,6 +49,15 @@ unsigned long soxrRecipe(ResamplerQuality q) {
     }
     return SOXR_MQ;
 }
+
+soxr_t createSoxr(double inputRate, double outputRate, ResamplerQuality quality) {
+    soxr_error_t err = nullptr;
+    const auto io = soxr_io_spec(SOXR_FLOAT32_I, SOXR_FLOAT32_I);
+    const auto q = soxr_quality_spec(soxrRecipe(quality), 0);
+    soxr_t soxr = soxr_create(inputRate, outputRate, 1, &err, &io, &q, nullptr);
+    if (err) throw std::runtime_error(std::string("libsoxr: ") + err);
+    return soxr;
+}
 }  // namespace
 
 StreamResampler::StreamResampler(double inputRate, double outputRate, ResamplerQuality quality,
@@ -34,11 +65,8 @@ StreamResampler::StreamResampler(double inputRate, double outputRate, ResamplerQ
     : state_(std::make_unique<State>()), inputRate_(inputRate), outputRate_(outputRate) {
     if (!(inputRate > 0) || !(outputRate > 0))
         throw InputError("resampler: rates must be positive");
-    soxr_error_t err = nullptr;
-    const auto io = soxr_io_spec(SOXR_FLOAT32_I, SOXR_FLOAT32_I);
-    const auto q = soxr_quality_spec(soxrRecipe(quality), 0);
-    state_->soxr = soxr_create(inputRate, outputRate, 1, &err, &io, &q, nullptr);
-    if (err) throw std::runtime_error(std::string("libsoxr: ") + err);
+    state_->soxr = createSoxr(inputRate, outputRate, quality);
+    delaySeconds_ = measureHeldBack(inputRate, outputRate, quality);
     state_->maxBlock = maxBlock;
     // Room for one block's worth of output plus what the filter may release on flush.
     const auto room = static_cast<std::size_t>(std::ceil(maxBlock * outputRate / inputRate)) + 4096;
@@ -60,6 +88,5 @@ std::span<const float> StreamResampler::process(std::span<const float> input, bo
     return {s.out.data(), made};
 }
 
-double StreamResampler::delaySeconds() const { return soxr_delay(state_->soxr) / outputRate_; }
 
 }  // namespace lipsyncd::dsp

@@ -53,5 +53,8 @@ TEST(StreamResampler, ReportedDelayMatchesTheMeasuredOne) {
     // Output is time-aligned with input: the peak sits where the impulse was.
     const auto peakAt = std::max_element(y.begin(), y.end()) - y.begin();
     EXPECT_NEAR(static_cast<double>(peakAt) / out, 0.1, 1.5 / out);
-    EXPECT_NEAR(measured, r.delaySeconds(), 0.004) << "reported " << r.delaySeconds();
+    // The bound holds, and is not loose: within 15 ms of what the impulse shows (one 10 ms probe block
+    // plus detection granularity).
+    EXPECT_LE(measured, r.delaySeconds() + 0.002) << "reported " << r.delaySeconds();
+    EXPECT_GE(measured, r.delaySeconds() - 0.015) << "reported " << r.delaySeconds();
 }

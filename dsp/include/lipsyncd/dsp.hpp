@@ -97,8 +97,11 @@ public:
     // Resamples one block (at most maxBlock samples); returns the output samples, which stay
     // valid until the next call. An empty input with `flush` drains what is held back.
     std::span<const float> process(std::span<const float> input, bool flush = false);
-    // The resampler's own delay in seconds (what it holds back), as libsoxr reports it.
-    double delaySeconds() const;
+    // The resampler's latency in seconds: the most audio it held back (input fed but not yet
+    // output) while 10 ms blocks of silence went through a twin of it at construction. libsoxr's
+    // own soxr_delay() counts only the filter, not the block it buffers before filtering, and
+    // so under-reports what a live path waits for (notes/dsp.md: "measure the resampler's delay").
+    double delaySeconds() const { return delaySeconds_; }
     double inputRate() const { return inputRate_; }
     double outputRate() const { return outputRate_; }
 
@@ -106,6 +109,7 @@ private:
     struct State;
     std::unique_ptr<State> state_;
     double inputRate_, outputRate_;
+    double delaySeconds_ = 0;
 };
 
 // ---------------------------------------------------------------------------------------------
