@@ -1,0 +1,133 @@
+// The `lipsync` tool as a user meets it: help, version, exit codes (0 ok, 1 runtime error,
+// 2 usage error), and errors on stderr that name the file and what is wrong.
+#include "RunLipsync.hpp"
+
+#include <lipsyncd/core.hpp>
+#include <lipsyncd/dsp.hpp>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace lipsyncd::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A spoken example, made once per test run by the tool itself (espeak-ng).
+const fs::path& exampleWav() {
+    static const fs::path wav = [] {
+        const auto dir = scratchDir("cli_example");
+        const auto path = dir / "hello.wav";
+        const auto r = runLipsync({"say", "Hello puppet, open wide.", "--wav", path.string(),
+                                   "--schedule", (dir / "hello.lab").string()});
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return path;
+    }();
+    return wav;
+}
+
+TEST(LipsyncCli, HelpListsEveryCommandAndExitsZero) {
+    const auto r = runLipsync({"--help"});
+    EXPECT_EQ(r.exitCode, 0);
+    for (const char* cmd : {"analyze", "eval", "train", "calibrate", "say"})
+        EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd;
+}
+
+TEST(LipsyncCli, EachCommandHasHelp) {
+    for (const char* cmd : {"analyze", "eval", "train", "calibrate", "say"}) {
+        const auto r = runLipsync({cmd, "--help"});
+        EXPECT_EQ(r.exitCode, 0) << cmd;
+        EXPECT_NE(r.out.find("Usage"), std::string::npos) << cmd;
+    }
+}
+
+TEST(LipsyncCli, VersionPrintsTheVersion) {
+    const auto r = runLipsync({"--version"});
+    EXPECT_EQ(r.exitCode, 0);
+    EXPECT_NE(r.out.find(LIPSYNCD_VERSION), std::string::npos) << r.out;
+}
+
+TEST(LipsyncCli, UsageErrorsExitTwo) {
+    EXPECT_EQ(runLipsync({}).exitCode, 2);
+    EXPECT_EQ(runLipsync({"frobnicate"}).exitCode, 2);
+    EXPECT_EQ(runLipsync({"analyze", "x.wav", "--bogus"}).exitCode, 2);
+    const auto r = runLipsync({"analyze", "x.wav", "-s", "-", "--format", "xml"});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("--format"), std::string::npos) << r.err;
+}
+
+TEST(LipsyncCli, MissingInputNamesTheFileAndExitsOne) {
+    const auto r = runLipsync({"analyze", "/nonexistent/speech.wav", "-s", "-"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("/nonexistent/speech.wav"), std::string::npos) << r.err;
+}
+
+TEST(LipsyncCli, NonAudioBytesNameTheFile) {
+    const auto path = scratchDir("cli_bad") / "notes.wav";
+    std::ofstream(path) << "these are not the samples you are looking for\n";
+    const auto r = runLipsync({"analyze", path.string(), "-s", "-"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find(path.string()), std::string::npos) << r.err;
+}
+
+TEST(LipsyncCli, AnalyzeWritesAScheduleThatReadsBack) {
+    const auto out = scratchDir("cli_analyze") / "hello.tsv";
+    const auto frames = out.parent_path() / "frames.csv";
+    const auto r = runLipsync({"analyze", exampleWav().string(), "-s", out.string(), "--frames",
+                               frames.string(), "-q"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto schedule = readScheduleFile(out);
+    ASSERT_GT(schedule.size(), 5u);
+    EXPECT_EQ(schedule.front().start, 0.0);
+    std::ifstream csv(frames);
+    std::string header;
+    std::getline(csv, header);
+    EXPECT_NE(header.find("runner_up"), std::string::npos) << header;
+}
+
+TEST(LipsyncCli, AnalyzeReadsRawPcmFromStdin) {
+    const auto raw = scratchDir("cli_raw") / "hello.f32";
+    {
+        const auto audio = dsp::readAudioFile(exampleWav());
+        std::ofstream(raw, std::ios::binary)
+            .write(reinterpret_cast<const char*>(audio.samples.data()),
+                   static_cast<std::streamsize>(audio.samples.size() * sizeof(float)));
+    }
+    const auto viaPipe = runLipsync({"analyze", "-", "--raw", "22050:f32:1", "-s", "-", "-q"}, raw);
+    const auto viaFile = runLipsync({"analyze", exampleWav().string(), "-s", "-", "-q"});
+    ASSERT_EQ(viaPipe.exitCode, 0) << viaPipe.err;
+    EXPECT_EQ(viaPipe.out, viaFile.out);
+}
+
+TEST(LipsyncCli, EvalFailsBelowTheFloorAndPassesAboveIt) {
+    const auto dir = exampleWav().parent_path();
+    EXPECT_EQ(runLipsync({"eval", "--corpus", dir.string(), "--min-accuracy", "0.05"}).exitCode, 0);
+    const auto r = runLipsync({"eval", "--corpus", dir.string(), "--min-accuracy", "0.999"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("below the floor"), std::string::npos) << r.err;
+}
+
+TEST(LipsyncCli, EvalOnAFolderWithoutLabelsSaysSo) {
+    const auto r = runLipsync({"eval", "--corpus", scratchDir("cli_empty").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("cli_empty"), std::string::npos) << r.err;
+}
+
+TEST(LipsyncCli, CalibrateBuildsLoadableTemplatesAndNamesStrayFiles) {
+    const auto dir = scratchDir("cli_calibrate");
+    // Sustained-ish sounds from espeak-ng stand in for a speaker's recordings.
+    for (const auto& [cls, text] : {std::pair{"aa", "ahhhhhh"}, {"ow", "ohhhhhh"}, {"sh", "shhhhhh"}})
+        ASSERT_EQ(runLipsync({"say", text, "--wav", (dir / (std::string(cls) + ".wav")).string()}).exitCode, 0);
+    std::ofstream(dir / "hum.wav") << "x";
+    const auto out = dir.parent_path() / "calibrated.json";
+    const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("hum.wav"), std::string::npos) << r.err;
+    const auto set = dsp::TemplateSet::load(out);
+    EXPECT_EQ(set.classes.size(), PhonemeSet::common().size());
+}
+
+}  // namespace
+}  // namespace lipsyncd::test
