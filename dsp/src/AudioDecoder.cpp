@@ -88,6 +88,11 @@ AudioDecoder AudioDecoder::open(const std::filesystem::path& file, const DecodeO
     s->file.reset(f);
     if (s->info.samplerate <= 0 || s->info.channels <= 0)
         throw InputError(s->name + ": no sample rate or no channels in the header");
+    // Outside this range a header is broken or hostile, not speech (a 1 Hz "WAV" would
+    // resample every byte into 10 000 analysis samples).
+    if (s->info.samplerate < 1000 || s->info.samplerate > 384000)
+        throw InputError(s->name + ": sample rate " + std::to_string(s->info.samplerate) +
+                         " Hz in the header is outside 1000..384000 Hz");
     if (options.channel >= s->info.channels)
         throw InputError(s->name + ": has " + std::to_string(s->info.channels) +
                          " channel(s); --channel " + std::to_string(options.channel) +

@@ -80,7 +80,6 @@ std::span<const PhonemeSegment> Segmenter::push(const FrameLabel& label) {
     if (!pending_.empty() && phoneme != pending_.back().phoneme &&
         label.confidence < config_.switchMargin)
         phoneme = pending_.back().phoneme;
-    const double start = std::max(0.0, label.time - hop_ / 2);
     const double end = label.time + hop_ / 2;
     if (!pending_.empty() && pending_.back().phoneme == phoneme) {
         auto& run = pending_.back();
@@ -90,7 +89,7 @@ std::span<const PhonemeSegment> Segmenter::push(const FrameLabel& label) {
         // The run before may now be final: this one has just reached its minimum.
         if (pending_.size() >= 2) settle(false);
     } else {
-        const double runStart = pending_.empty() ? (emittedUntil_ > 0 ? emittedUntil_ : start)
+        const double runStart = pending_.empty() ? emittedUntil_  // the first run starts at 0
                                                  : pending_.back().end;
         pending_.push_back({phoneme, runStart, end, label.confidence, 1});
         if (pending_.size() >= 2) absorbIfFlicker(pending_.size() - 2);

@@ -19,7 +19,6 @@ FrontEndConfig withTemplateAnalysis(FrontEndConfig config, const TemplateSet& te
 StreamingAnalyzer::StreamingAnalyzer(const TemplateSet& templates, const PhonemeSet& set,
                                      double inputRate, const FrontEndConfig& config)
     : templates_(templates),
-      set_(&set),
       config_(withTemplateAnalysis(config, templates)),
       frames_(config_.analysis, inputRate, config_.resamplerQuality),
       classifier_(templates_, set, config_.classifier),

@@ -116,3 +116,21 @@ TEST(TemplateSet, ShippedDefaultLoadsAndCoversTheCommonSet) {
     EXPECT_EQ(t.analysis.analysisRate, 10000);
     EXPECT_EQ(t.analysis.order, 12);
 }
+
+TEST(Segmenter, TheScheduleStartsAtZeroWhateverTheFirstFrameTime) {
+    // The first analysis frame is centred half a window in (12.5 ms), not at half a hop.
+    const auto& set = PhonemeSet::common();
+    dsp::Segmenter seg(set, 0.01);
+    PhonemeSchedule out;
+    for (int i = 0; i < 20; ++i) {
+        dsp::FrameLabel l;
+        l.time = 0.0125 + 0.01 * i;
+        l.phoneme = static_cast<int>(*set.find(i < 10 ? "aa" : "sil"));
+        for (const auto& s : seg.push(l)) out.push_back(s);
+    }
+    for (const auto& s : seg.finish(0.22)) out.push_back(s);
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_EQ(out[0].start, 0.0);
+    EXPECT_EQ(out[1].start, out[0].end);
+    EXPECT_DOUBLE_EQ(out[1].end, 0.22);
+}

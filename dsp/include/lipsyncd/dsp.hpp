@@ -349,7 +349,6 @@ private:
     void onFeatures(const FrameFeatures& features);
 
     TemplateSet templates_;
-    const PhonemeSet* set_;
     FrontEndConfig config_;
     FrameStream frames_;
     FrameClassifier classifier_;
