@@ -17,7 +17,6 @@ LpcResult levinsonDurbin(std::span<const float> r, int order) {
     order = std::min({order, kMaxOrder, static_cast<int>(r.size()) - 1});
     // Double precision inside: the recursion loses digits at order 12+ on peaky spectra.
     std::array<double, kMaxOrder + 1> a{};
-    std::array<double, kMaxOrder + 1> previous{};
     a[0] = 1.0;
     double error = r.empty() ? 0.0 : r[0];
     if (!(error > 0) || !std::isfinite(error)) {
@@ -34,8 +33,12 @@ LpcResult levinsonDurbin(std::span<const float> r, int order) {
             out.stable = false;
             break;
         }
-        previous = a;
-        for (int j = 1; j < i; ++j) a[j] = previous[j] + k * previous[i - j];
+        // a_j ← a_j + k·a_(i−j) for j < i, in place: update the pair (j, i−j) together.
+        for (int j = 1, m = i - 1; j <= m; ++j, --m) {
+            const double aj = a[j], am = a[m];
+            a[j] = aj + k * am;
+            if (j != m) a[m] = am + k * aj;
+        }
         a[i] = k;
         out.k[i - 1] = static_cast<float>(k);
         error *= 1.0 - k * k;

@@ -170,6 +170,9 @@ public:
     const AnalysisConfig& config() const { return config_; }
 
 private:
+    void measureLevel(std::span<const float> frame, FrameFeatures& out) const;
+    void autocorrelate();
+
     AnalysisConfig config_;
     std::vector<float> window_, buffer_, lagWindow_;
     std::unique_ptr<DirectLpcSpectrum> direct_;
