@@ -17,20 +17,23 @@ struct Collector {
     std::vector<std::pair<double, std::string>> events;  // (time s, mnemonic)
 };
 
+// espeak-ng hands over audio in chunks, each with the events inside it. A chunk may carry no
+// events at all: its list is then only the terminator, which still carries our user_data, so
+// the collector is found on every entry including the terminator (dropping such chunks loses
+// audio and slides every later label).
 int onSynth(short* wav, int count, espeak_EVENT* events) {
-    for (espeak_EVENT* e = events; e && e->type != espeakEVENT_LIST_TERMINATED; ++e) {
-        auto* c = static_cast<Collector*>(e->user_data);
-        if (!c) continue;
-        if (e->type == espeakEVENT_PHONEME) {
+    Collector* collector = nullptr;
+    for (espeak_EVENT* e = events; e; ++e) {
+        if (e->user_data) collector = static_cast<Collector*>(e->user_data);
+        if (collector && e->type == espeakEVENT_PHONEME) {
             char name[9] = {};
             std::memcpy(name, e->id.string, 8);
-            c->events.emplace_back(e->audio_position / 1000.0, name);
+            collector->events.emplace_back(e->audio_position / 1000.0, name);
         }
-        if (wav && count > 0 && c->samples) {
-            c->samples->insert(c->samples->end(), wav, wav + count);
-            wav = nullptr;  // samples belong to the whole callback, add them once
-        }
+        if (e->type == espeakEVENT_LIST_TERMINATED) break;
     }
+    if (collector && wav && count > 0 && collector->samples)
+        collector->samples->insert(collector->samples->end(), wav, wav + count);
     return 0;  // continue synthesis
 }
 

@@ -1,0 +1,64 @@
+// espeak-ng synthesis: the audio and the phoneme events must agree, since every label in the
+// training and dev corpora comes from these events.
+#include <lipsyncd/tts.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace lipsyncd {
+namespace {
+
+double rmsDbfs(const SynthesizedSpeech& s, double from, double to) {
+    const auto a = static_cast<std::size_t>(from * s.sampleRate);
+    const auto b = std::min(s.samples.size(), static_cast<std::size_t>(to * s.sampleRate));
+    double sum = 0;
+    for (std::size_t i = a; i < b; ++i) sum += double(s.samples[i]) * s.samples[i];
+    return 10 * std::log10(sum / std::max<std::size_t>(1, b - a) / (32768.0 * 32768.0) + 1e-12);
+}
+
+EspeakSynthesizer& synthesizer() {
+    static EspeakSynthesizer synth;  // espeak-ng allows one at a time
+    return synth;
+}
+
+SynthesizedSpeech speak(const std::string& text, int rate = 165) {
+    return synthesizer().synthesize({text, "en-us", rate, -1});
+}
+
+TEST(EspeakSynthesizer, EveryPhonemeEventFallsInsideTheAudio) {
+    // Several sentences: espeak-ng then delivers audio chunks that carry no events.
+    const auto s = speak("Hello there! I am a puppet. Watch my mouth move, and wave back at me.");
+    const double total = static_cast<double>(s.samples.size()) / s.sampleRate;
+    ASSERT_FALSE(s.phonemes.empty());
+    // The final phoneme is the closing pause; the word before it ("me") must be in the schedule.
+    bool sawLastVowel = false;
+    for (const auto& p : s.phonemes) sawLastVowel |= p.phoneme == "i:";
+    EXPECT_TRUE(sawLastVowel);
+    EXPECT_NEAR(s.phonemes.back().end, total, 0.001);
+}
+
+TEST(EspeakSynthesizer, PausesInTheEventsAreQuietInTheAudio) {
+    const auto s = speak("Hello there! I am a puppet. Watch my mouth move.");
+    const double speech = rmsDbfs(s, 0, static_cast<double>(s.samples.size()) / s.sampleRate);
+    int pauses = 0;
+    for (const auto& p : s.phonemes) {
+        if (p.phoneme.rfind('_', 0) != 0 || p.end - p.start < 0.08) continue;
+        ++pauses;
+        EXPECT_LT(rmsDbfs(s, p.start + 0.02, p.end - 0.02), speech - 30)
+            << "pause at " << p.start << "-" << p.end << " s is not quiet";
+    }
+    EXPECT_GE(pauses, 2);
+}
+
+TEST(EspeakSynthesizer, UnknownVoiceIsAnInputErrorNamingIt) {
+    try {
+        synthesizer().synthesize({"hello", "xx-nowhere", 0, -1});
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("xx-nowhere"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace lipsyncd
