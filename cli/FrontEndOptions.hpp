@@ -15,6 +15,7 @@ struct FrontEndOptions {
     int channel = -1;
     std::string rawSpec;
     std::string resampler = "medium";
+    dsp::SegmenterConfig segmenter;
 
     void addTo(CLI::App& cmd) {
         cmd.add_option("--templates", templates,
@@ -28,6 +29,15 @@ struct FrontEndOptions {
         cmd.add_option("--resampler", resampler, "Resampler quality")
             ->check(CLI::IsMember({"low", "medium", "high", "veryhigh"}))
             ->capture_default_str();
+        // Shorter runs are flicker and merge into their neighbour; longer holds mean fewer,
+        // steadier segments and a longer streaming delay (the longest minimum plus a hop).
+        cmd.add_option("--min-vowel", segmenter.minVowelSeconds, "Shortest vowel segment, seconds")
+            ->check(CLI::Range(0.0, 0.5))->capture_default_str();
+        cmd.add_option("--min-consonant", segmenter.minConsonantSeconds,
+                       "Shortest consonant segment, seconds")
+            ->check(CLI::Range(0.0, 0.5))->capture_default_str();
+        cmd.add_option("--min-silence", segmenter.minSilenceSeconds, "Shortest silence, seconds")
+            ->check(CLI::Range(0.0, 0.5))->capture_default_str();
     }
 
     dsp::TemplateSet loadTemplates() const {
@@ -41,6 +51,7 @@ struct FrontEndOptions {
     }
     dsp::FrontEndConfig config() const {
         dsp::FrontEndConfig c;
+        c.segmenter = segmenter;
         if (resampler == "low") c.resamplerQuality = dsp::ResamplerQuality::Low;
         if (resampler == "high") c.resamplerQuality = dsp::ResamplerQuality::High;
         if (resampler == "veryhigh") c.resamplerQuality = dsp::ResamplerQuality::VeryHigh;

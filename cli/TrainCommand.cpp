@@ -16,6 +16,7 @@ struct TrainOptions {
     std::string labels = "auto";
     dsp::TrainingOptions training;
     std::string description;
+    std::vector<std::string> extraFeatures{"log_error", "level"};
 };
 
 void runTrain(const TrainOptions& o) {
@@ -59,13 +60,28 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_option("--labels", o->labels, "Label alphabet: auto, common, arpabet, or a map name/file")
         ->capture_default_str();
     cmd->add_option("--clusters", o->training.clustersPerClass, "Cluster means per class")
-        ->check(CLI::Range(1, 16))->capture_default_str();
+        ->check(CLI::Range(1, 64))->capture_default_str();
     cmd->add_option("--order", o->training.analysis.order, "LPC order")
         ->check(CLI::Range(2, dsp::kMaxOrder))->capture_default_str();
     cmd->add_option("--bins", o->training.analysis.spectrumBins, "Spectrum points 0..rate/2")
         ->check(CLI::Range(4, 512))->capture_default_str();
+    cmd->add_option("--extra-features", o->extraFeatures,
+                    "Features after the spectrum: log_error, level (comma list, or 'none')")
+        ->delimiter(',')->capture_default_str();
     cmd->add_option("--description", o->description, "Description stored in the file");
-    cmd->callback([o] { runTrain(*o); });
+    cmd->callback([o] {
+        auto& a = o->training.analysis;
+        a.errorFeature = a.levelFeature = false;
+        for (const auto& f : o->extraFeatures) {
+            if (f == "log_error")
+                a.errorFeature = true;
+            else if (f == "level")
+                a.levelFeature = true;
+            else if (f != "none")
+                throw CLI::ValidationError("--extra-features", "unknown feature '" + f + "' (known: log_error, level, none)");
+        }
+        runTrain(*o);
+    });
 }
 
 }  // namespace lipsyncd::cli

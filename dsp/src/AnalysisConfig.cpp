@@ -30,6 +30,7 @@ void AnalysisConfig::validate() const {
     if (spectrumBins < 4 || spectrumBins > 512) bad("bins", "must be 4..512");
     if (spectrumByFft && (spectrumBins & (spectrumBins - 1)) != 0)
         bad("bins", "must be a power of two for FFT evaluation");
+    if (!(levelPeakDecayDbPerSecond > 0)) bad("level_peak_decay", "must be > 0 dB/s");
 }
 
 }  // namespace lipsyncd::dsp

@@ -49,7 +49,7 @@ FrameAnalyzer::~FrameAnalyzer() = default;
 
 FrameFeatures FrameAnalyzer::makeFeatures() const {
     FrameFeatures f;
-    f.spectrum.assign(config_.spectrumBins, 0.0f);
+    f.spectrum.assign(static_cast<std::size_t>(config_.featureCount()), 0.0f);
     return f;
 }
 
@@ -127,15 +127,27 @@ void FrameAnalyzer::analyze(std::span<const float> frame, FrameFeatures& out) {
     out.lpc = levinsonDurbin(std::span<const float>(r_.data(), p + 1), p);
     out.normalizedError = out.lpc.normalizedError;
     out.valid = out.energyDb > kSilentFrameDb && out.lpc.stable && std::isfinite(out.normalizedError);
-    if (!out.valid) {
-        // A flat spectrum: the classifier sees "nothing", the energy gate calls it silence.
-        std::fill(out.spectrum.begin(), out.spectrum.end(), 0.0f);
-        return;
-    }
-    if (fft_)
-        fft_->evaluate(std::span<const float>(out.lpc.a.data(), p + 1), out.spectrum);
+    const auto bins = static_cast<std::size_t>(config_.spectrumBins);
+    const auto spectrum = std::span<float>(out.spectrum).first(bins);
+    if (!out.valid)  // a flat spectrum: the classifier sees "nothing", the gate calls it silence
+        std::fill(spectrum.begin(), spectrum.end(), 0.0f);
+    else if (fft_)
+        fft_->evaluate(std::span<const float>(out.lpc.a.data(), p + 1), spectrum);
     else
-        direct_->evaluate(std::span<const float>(out.lpc.a.data(), p + 1), out.spectrum);
+        direct_->evaluate(std::span<const float>(out.lpc.a.data(), p + 1), spectrum);
+    addExtraFeatures(out);
+}
+
+void FrameAnalyzer::addExtraFeatures(FrameFeatures& out) {
+    std::size_t at = static_cast<std::size_t>(config_.spectrumBins);
+    if (config_.errorFeature)
+        out.spectrum[at++] = out.valid ? std::max(-40.0f, 10.0f * std::log10(out.normalizedError)) : 0.0f;
+    if (config_.levelFeature) {
+        // The peak follows loud frames at once and decays slowly through quiet ones.
+        const auto decay = static_cast<float>(config_.levelPeakDecayDbPerSecond * config_.hopSeconds);
+        peakDb_ = std::max(out.energyDb, peakDb_ - decay);
+        out.spectrum[at++] = std::max(-60.0f, out.energyDb - peakDb_);
+    }
 }
 
 }  // namespace lipsyncd::dsp

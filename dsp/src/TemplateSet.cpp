@@ -37,6 +37,19 @@ AnalysisConfig readAnalysis(const json& a, const std::string& source) {
     c.lagWindowHz = member<double>(a, "lag_window_hz", p, source);
     c.whiteNoiseCorrection = member<double>(a, "white_noise_correction", p, source);
     c.spectrumBins = member<int>(a, "bins", p, source);
+    // Optional (sets written before it existed have none): names of features after the spectrum.
+    if (a.contains("extra_features")) {
+        for (const auto& name : member<std::vector<std::string>>(a, "extra_features", p, source)) {
+            if (name == "log_error")
+                c.errorFeature = true;
+            else if (name == "level")
+                c.levelFeature = true;
+            else
+                throw InputError(source, 0, "analysis.extra_features: unknown feature '" + name +
+                                                "' (known: log_error, level)");
+        }
+        if (c.levelFeature) c.levelPeakDecayDbPerSecond = member<double>(a, "level_peak_decay", p, source);
+    }
     try {
         c.validate();
     } catch (const InputError& e) {
@@ -46,11 +59,18 @@ AnalysisConfig readAnalysis(const json& a, const std::string& source) {
 }
 
 json writeAnalysis(const AnalysisConfig& c) {
-    return {{"rate", c.analysisRate},         {"hop", c.hopSeconds},
+    json a = {{"rate", c.analysisRate},         {"hop", c.hopSeconds},
             {"window", c.windowSeconds},      {"order", c.order},
             {"pre_emphasis", c.preEmphasis},  {"lag_window_hz", c.lagWindowHz},
             {"white_noise_correction", c.whiteNoiseCorrection},
             {"bins", c.spectrumBins}};
+    auto& extra = a["extra_features"] = json::array();
+    if (c.errorFeature) extra.push_back("log_error");
+    if (c.levelFeature) {
+        extra.push_back("level");
+        a["level_peak_decay"] = c.levelPeakDecayDbPerSecond;
+    }
+    return a;
 }
 
 // Three decimals (0.001 dB is far below anything a distance can tell) as doubles, so the file
@@ -63,10 +83,12 @@ std::vector<double> rounded(const std::vector<float>& v) {
 }  // namespace
 
 void TemplateSet::validate(const std::string& source) const {
-    const auto bins = static_cast<std::size_t>(analysis.spectrumBins);
+    // One weight and one template value per feature: the spectrum's bins, then the extras.
+    const auto bins = static_cast<std::size_t>(analysis.featureCount());
     if (binWeights.size() != bins)
         throw InputError(source, 0, "bin_weights has " + std::to_string(binWeights.size()) +
-                                        " values, analysis.bins is " + std::to_string(bins));
+                                        " values, the analysis has " + std::to_string(bins) +
+                                        " features");
     for (std::size_t b = 0; b < bins; ++b)
         if (!(binWeights[b] >= 0) || !std::isfinite(binWeights[b]))
             throw InputError(source, 0, "bin_weights[" + std::to_string(b) + "] must be >= 0");

@@ -109,7 +109,7 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
     TemplateSet t;
     t.analysis = options_.analysis;
     t.description = description;
-    const auto bins = static_cast<std::size_t>(options_.analysis.spectrumBins);
+    const auto bins = static_cast<std::size_t>(options_.analysis.featureCount());
     // Pooled within-class variance per bin: bins where classes differ more than frames of one
     // class scatter get more weight (inverse variance; notes/dsp.md, Tohkura 1987).
     std::vector<double> variance(bins, 0.0);

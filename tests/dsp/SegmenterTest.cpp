@@ -108,6 +108,16 @@ TEST(TemplateSet, MalformedFilesNameTheField) {
     EXPECT_NE(errorOf(head + R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "aa", "spectra": "no"}]})")
                   .find("classes[0].spectra"),
               std::string::npos);
+    // Extra features: unknown names are refused; known ones widen every vector.
+    const std::string extra = R"({"format": "lipsyncd-templates", "version": 1, "analysis": {"rate": 10000,
+        "hop": 0.01, "window": 0.025, "order": 12, "pre_emphasis": 0.97, "lag_window_hz": 60,
+        "white_noise_correction": 0.0001, "bins": 4, "extra_features": )";
+    EXPECT_NE(errorOf(extra + R"(["pitch"]}, "bin_weights": [1,1,1,1], "classes": []})")
+                  .find("unknown feature 'pitch'"),
+              std::string::npos);
+    EXPECT_NE(errorOf(extra + R"(["log_error"]}, "bin_weights": [1,1,1,1], "classes": []})")
+                  .find("bin_weights has 4 values, the analysis has 5 features"),
+              std::string::npos);
 }
 
 TEST(TemplateSet, ShippedDefaultLoadsAndCoversTheCommonSet) {
