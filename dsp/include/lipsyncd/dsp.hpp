@@ -97,10 +97,10 @@ public:
     // Resamples one block (at most maxBlock samples); returns the output samples, which stay
     // valid until the next call. An empty input with `flush` drains what is held back.
     std::span<const float> process(std::span<const float> input, bool flush = false);
-    // The resampler's latency in seconds: the most audio it held back (input fed but not yet
-    // output) while 10 ms blocks of silence went through a twin of it at construction. libsoxr's
-    // own soxr_delay() counts only the filter, not the block it buffers before filtering, and
-    // so under-reports what a live path waits for (notes/dsp.md: "measure the resampler's delay").
+    // The resampler's latency in seconds: the longest a sample waited (from going in to coming
+    // out) while 10 ms blocks went through a twin of it at construction. libsoxr's own
+    // soxr_delay() counts only the filter, not the block it buffers before filtering, and so
+    // under-reports what a live path waits for (notes/dsp.md: "measure the resampler's delay").
     double delaySeconds() const { return delaySeconds_; }
     double inputRate() const { return inputRate_; }
     double outputRate() const { return outputRate_; }
