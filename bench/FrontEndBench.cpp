@@ -6,15 +6,15 @@
 //
 // Counters: x_realtime = seconds of audio analysed per second of CPU; per-frame stages report
 // their time per frame (one iteration = one frame, or one 10 ms block for the resampler).
-#include "TestSpeech.hpp"
-
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <unistd.h>
+
+#include "TestSpeech.hpp"
 
 namespace {
 
@@ -27,12 +27,14 @@ const std::vector<float>& speechAt(int rate) {
     if (out.empty()) {
         const auto& s = test::testSpeech();
         const auto once = test::resampleOffline(s.samples, s.rate, rate);
-        while (out.size() < static_cast<std::size_t>(30 * rate)) out.insert(out.end(), once.begin(), once.end());
+        while (out.size() < static_cast<std::size_t>(30 * rate))
+            out.insert(out.end(), once.begin(), once.end());
     }
     return out;
 }
 
-std::vector<dsp::FrameFeatures> featuresOf(const std::vector<float>& audio, const dsp::AnalysisConfig& config) {
+std::vector<dsp::FrameFeatures> featuresOf(const std::vector<float>& audio,
+                                           const dsp::AnalysisConfig& config) {
     dsp::FrameStream stream(config, 10000);
     std::vector<dsp::FrameFeatures> out;
     stream.push(audio, [&](const dsp::FrameFeatures& f) { out.push_back(f); });
@@ -42,7 +44,8 @@ std::vector<dsp::FrameFeatures> featuresOf(const std::vector<float>& audio, cons
 
 void WholeFile16kHz(benchmark::State& state) {
     const auto& audio = speechAt(16000);
-    const auto file = test::writeAudio("bench16k.wav", audio, 16000, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+    const auto file =
+        test::writeAudio("bench16k.wav", audio, 16000, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
     const auto templates = dsp::TemplateSet::loadDefault();
     for (auto _ : state) {
         auto result = dsp::analyzeFile(file, templates, PhonemeSet::common());
@@ -78,7 +81,8 @@ void LevinsonDurbin(benchmark::State& state) {
     // The recursion's cost depends only on the order: a damped cosine, shaped like the
     // autocorrelation of a voiced frame, stands in for real frames.
     std::vector<float> r(static_cast<std::size_t>(order) + 1);
-    for (int i = 0; i <= order; ++i) r[static_cast<std::size_t>(i)] = std::pow(0.9f, static_cast<float>(i)) * std::cos(0.3f * i);
+    for (int i = 0; i <= order; ++i)
+        r[static_cast<std::size_t>(i)] = std::pow(0.9f, static_cast<float>(i)) * std::cos(0.3f * i);
     for (auto _ : state) benchmark::DoNotOptimize(dsp::levinsonDurbin(r, order));
 }
 BENCHMARK(LevinsonDurbin)->Arg(12)->Arg(24);
@@ -102,7 +106,8 @@ void Resample10ms(benchmark::State& state) {
     const auto block = static_cast<std::size_t>(rate / 100);
     std::size_t at = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(resampler.process(std::span<const float>(audio).subspan(at, block)).data());
+        benchmark::DoNotOptimize(
+            resampler.process(std::span<const float>(audio).subspan(at, block)).data());
         at = at + 2 * block < audio.size() ? at + block : 0;
     }
     state.counters["delay_ms"] = 1000 * resampler.delaySeconds();
@@ -155,7 +160,8 @@ void StreamOneHour(benchmark::State& state) {
     state.counters["rss_growth_MiB"] = static_cast<double>(residentKiB() - before) / 1024;
     state.counters["peak_rss_MiB"] = static_cast<double>(usage.ru_maxrss) / 1024;
     state.counters["segments"] = static_cast<double>(segments);
-    state.counters["x_realtime"] = benchmark::Counter(3600, benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["x_realtime"] =
+        benchmark::Counter(3600, benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(StreamOneHour)->Iterations(1)->Unit(benchmark::kSecond)->MeasureProcessCPUTime();
 

@@ -1,13 +1,12 @@
 // lipsync analyze: audio to a phoneme schedule by the LPC front end.
-#include "Commands.hpp"
-#include "FrontEndOptions.hpp"
-#include "Output.hpp"
-
+#include <iomanip>
+#include <iostream>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/dsp.hpp>
 
-#include <iomanip>
-#include <iostream>
+#include "Commands.hpp"
+#include "FrontEndOptions.hpp"
+#include "Output.hpp"
 
 namespace lipsyncd::cli {
 
@@ -46,8 +45,8 @@ void runAnalyze(const AnalyzeOptions& o) {
     if (!o.quiet)
         std::cerr << "lipsync analyze: " << o.input << ": " << std::fixed << std::setprecision(2)
                   << result.durationSeconds << " s at " << result.inputRate << " Hz, "
-                  << result.schedule.size() << " segments (resampler delay "
-                  << std::setprecision(1) << result.resamplerDelaySeconds * 1000 << " ms)\n";
+                  << result.schedule.size() << " segments (resampler delay " << std::setprecision(1)
+                  << result.resamplerDelaySeconds * 1000 << " ms)\n";
     withOutputStream(o.schedule, [&](std::ostream& out) {
         if (o.format == "json")
             writeScheduleJson(out, result.schedule);

@@ -1,11 +1,10 @@
 // lipsync calibrate: a speaker's own templates from a few sustained sounds (aa.wav, ih.wav,
 // bmp.wav, ...), on top of a base set for the classes not recorded.
-#include "Commands.hpp"
-
-#include <lipsyncd/dsp.hpp>
-
 #include <algorithm>
 #include <iostream>
+#include <lipsyncd/dsp.hpp>
+
+#include "Commands.hpp"
 
 namespace lipsyncd::cli {
 
@@ -39,14 +38,17 @@ void runCalibrate(const CalibrateOptions& o) {
         if (ext != ".wav" && ext != ".flac" && ext != ".ogg") continue;
         const auto cls = classOfFile(entry.path());
         if (!set.find(cls)) {
-            std::cerr << "lipsync calibrate: skipped " << entry.path().string() << ": '" << cls
-                      << "' is not a phoneme class (name files after a class: aa.wav, bmp.wav...)\n";
+            std::cerr
+                << "lipsync calibrate: skipped " << entry.path().string() << ": '" << cls
+                << "' is not a phoneme class (name files after a class: aa.wav, bmp.wav...)\n";
             continue;
         }
         trainer.addSustained(dsp::analyzeFrames(entry.path(), training.analysis), cls);
-        if (std::find(recorded.begin(), recorded.end(), cls) == recorded.end()) recorded.push_back(cls);
+        if (std::find(recorded.begin(), recorded.end(), cls) == recorded.end())
+            recorded.push_back(cls);
     }
-    if (recorded.empty()) throw InputError(o.folder + ": no recordings named after a phoneme class");
+    if (recorded.empty())
+        throw InputError(o.folder + ": no recordings named after a phoneme class");
     const auto own = trainer.build("calibration");
     for (const auto& cls : own.classes) {
         auto it = std::find_if(base.classes.begin(), base.classes.end(),
@@ -77,9 +79,11 @@ void addCalibrateCommand(CLI::App& app) {
         "(aa.wav, ih.wav, w.wav, bmp.wav, ...)");
     cmd->add_option("folder", o->folder, "Folder of recordings")->required();
     cmd->add_option("-o,--output", o->output, "Template file to write (JSON)")->required();
-    cmd->add_option("--base", o->base, "Templates for the classes not recorded (default: shipped set)");
+    cmd->add_option("--base", o->base,
+                    "Templates for the classes not recorded (default: shipped set)");
     cmd->add_option("--clusters", o->clusters, "Cluster means per recorded class")
-        ->check(CLI::Range(1, 8))->capture_default_str();
+        ->check(CLI::Range(1, 8))
+        ->capture_default_str();
     cmd->callback([o] { runCalibrate(*o); });
 }
 

@@ -15,12 +15,14 @@ std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>
         auto lab = entry.path();
         lab.replace_extension(".lab");
         if (!fs::exists(lab)) {
-            if (skipped) skipped->push_back(entry.path().string() + ": no " + lab.filename().string());
+            if (skipped)
+                skipped->push_back(entry.path().string() + ": no " + lab.filename().string());
             continue;
         }
         items.push_back({entry.path().stem().string(), entry.path(), lab});
     }
-    std::sort(items.begin(), items.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+    std::sort(items.begin(), items.end(),
+              [](const auto& a, const auto& b) { return a.name < b.name; });
     if (items.empty()) throw InputError(dir.string() + ": no NAME.wav + NAME.lab pairs");
     return items;
 }

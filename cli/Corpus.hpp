@@ -2,9 +2,8 @@
 // `start end phoneme`, ARPAbet in any case with stress digits, or common-set names).
 #pragma once
 
-#include <lipsyncd/core.hpp>
-
 #include <filesystem>
+#include <lipsyncd/core.hpp>
 #include <string>
 #include <vector>
 

@@ -1,16 +1,14 @@
 // lipsync eval: how well `analyze` agrees with reference labels, over a corpus.
+#include <iomanip>
+#include <iostream>
+#include <lipsyncd/dsp.hpp>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
 #include "Commands.hpp"
 #include "Corpus.hpp"
 #include "FrontEndOptions.hpp"
 #include "Output.hpp"
-
-#include <lipsyncd/dsp.hpp>
-
-#include <nlohmann/json.hpp>
-
-#include <iomanip>
-#include <sstream>
-#include <iostream>
 
 namespace lipsyncd::cli {
 
@@ -37,8 +35,8 @@ void printReport(std::ostream& out, const std::vector<FileScore>& files,
             << std::setw(10) << "accuracy" << std::setw(8) << "group" << '\n';
         for (const auto& f : files)
             out << std::left << std::setw(32) << f.name << std::right << std::setw(8)
-                << f.score.frames << std::setw(9) << 100 * f.score.accuracy() << '%'
-                << std::setw(7) << 100 * f.score.groupAccuracy() << "%\n";
+                << f.score.frames << std::setw(9) << 100 * f.score.accuracy() << '%' << std::setw(7)
+                << 100 * f.score.groupAccuracy() << "%\n";
         out << '\n';
     }
     out << "per class (reference): frames, recall, most often taken for\n";
@@ -46,13 +44,15 @@ void printReport(std::ostream& out, const std::vector<FileScore>& files,
         std::size_t n = 0, worst = r;
         for (std::size_t h = 0; h < set.size(); ++h) {
             n += total.confusion[r][h];
-            if (h != r && total.confusion[r][h] > (worst == r ? 0 : total.confusion[r][worst])) worst = h;
+            if (h != r && total.confusion[r][h] > (worst == r ? 0 : total.confusion[r][worst]))
+                worst = h;
         }
         if (n == 0) continue;
         out << "  " << std::left << std::setw(5) << set[r].name << std::right << std::setw(7) << n
             << std::setw(8) << 100.0 * total.confusion[r][r] / n << '%';
         if (worst != r)
-            out << "   " << set[worst].name << " (" << 100.0 * total.confusion[r][worst] / n << "%)";
+            out << "   " << set[worst].name << " (" << 100.0 * total.confusion[r][worst] / n
+                << "%)";
         out << '\n';
     }
     out << "\nfiles " << files.size() << ", frames " << total.frames << ": accuracy "
@@ -95,7 +95,8 @@ void runEval(const EvalOptions& o) {
     }
     printReport(std::cout, files, total, set, o.perFile);
     if (!o.json.empty())
-        withOutputStream(o.json, [&](std::ostream& out) { out << toJson(files, total, set).dump(1) << '\n'; });
+        withOutputStream(
+            o.json, [&](std::ostream& out) { out << toJson(files, total, set).dump(1) << '\n'; });
     if (total.accuracy() < o.minAccuracy || total.groupAccuracy() < o.minGroupAccuracy) {
         std::ostringstream msg;
         msg << std::fixed << std::setprecision(1) << "accuracy " << 100 * total.accuracy()
@@ -109,15 +110,19 @@ void runEval(const EvalOptions& o) {
 void addEvalCommand(CLI::App& app) {
     auto o = std::make_shared<EvalOptions>();
     auto* cmd = app.add_subcommand(
-        "eval", "Score 'analyze' against reference labels on every NAME.wav + NAME.lab in a folder");
+        "eval",
+        "Score 'analyze' against reference labels on every NAME.wav + NAME.lab in a folder");
     cmd->add_option("--corpus", o->corpus, "Folder of NAME.wav + NAME.lab")->required();
-    cmd->add_option("--labels", o->labels, "Label alphabet: auto, common, arpabet, or a map name/file")
+    cmd->add_option("--labels", o->labels,
+                    "Label alphabet: auto, common, arpabet, or a map name/file")
         ->capture_default_str();
     cmd->add_option("--json", o->json, "Also write the figures as JSON ('-' for stdout)");
     cmd->add_option("--min-accuracy", o->minAccuracy,
-                    "Exit 1 when frame accuracy (0..1) falls below this")->check(CLI::Range(0.0, 1.0));
+                    "Exit 1 when frame accuracy (0..1) falls below this")
+        ->check(CLI::Range(0.0, 1.0));
     cmd->add_option("--min-group-accuracy", o->minGroupAccuracy,
-                    "Exit 1 when visual-group accuracy (0..1) falls below this")->check(CLI::Range(0.0, 1.0));
+                    "Exit 1 when visual-group accuracy (0..1) falls below this")
+        ->check(CLI::Range(0.0, 1.0));
     cmd->add_flag("!--no-per-file", o->perFile, "Leave out the per-file table");
     o->frontEnd.addTo(*cmd);
     cmd->callback([o] { runEval(*o); });

@@ -1,10 +1,8 @@
 // Options every command that runs the front end shares: templates, channel, raw input.
 #pragma once
 
-#include <lipsyncd/dsp.hpp>
-
 #include <CLI/CLI.hpp>
-
+#include <lipsyncd/dsp.hpp>
 #include <optional>
 #include <string>
 
@@ -32,12 +30,15 @@ struct FrontEndOptions {
         // Shorter runs are flicker and merge into their neighbour; longer holds mean fewer,
         // steadier segments and a longer streaming delay (the longest minimum plus a hop).
         cmd.add_option("--min-vowel", segmenter.minVowelSeconds, "Shortest vowel segment, seconds")
-            ->check(CLI::Range(0.0, 0.5))->capture_default_str();
+            ->check(CLI::Range(0.0, 0.5))
+            ->capture_default_str();
         cmd.add_option("--min-consonant", segmenter.minConsonantSeconds,
                        "Shortest consonant segment, seconds")
-            ->check(CLI::Range(0.0, 0.5))->capture_default_str();
+            ->check(CLI::Range(0.0, 0.5))
+            ->capture_default_str();
         cmd.add_option("--min-silence", segmenter.minSilenceSeconds, "Shortest silence, seconds")
-            ->check(CLI::Range(0.0, 0.5))->capture_default_str();
+            ->check(CLI::Range(0.0, 0.5))
+            ->capture_default_str();
     }
 
     dsp::TemplateSet loadTemplates() const {

@@ -1,11 +1,10 @@
 // lipsync train: spectral templates from labelled audio (cluster means per class).
-#include "Commands.hpp"
-#include "Corpus.hpp"
-
-#include <lipsyncd/dsp.hpp>
-
 #include <iomanip>
 #include <iostream>
+#include <lipsyncd/dsp.hpp>
+
+#include "Commands.hpp"
+#include "Corpus.hpp"
 
 namespace lipsyncd::cli {
 
@@ -38,12 +37,13 @@ void runTrain(const TrainOptions& o) {
                           << std::setprecision(0) << seconds << " s of audio\n";
         }
     }
-    auto templates = trainer.build(o.description.empty()
-                                       ? "trained by 'lipsync train' from " + std::to_string(files) + " files"
-                                       : o.description);
+    auto templates = trainer.build(o.description.empty() ? "trained by 'lipsync train' from " +
+                                                               std::to_string(files) + " files"
+                                                         : o.description);
     templates.save(o.output);
     std::cerr << "lipsync train: " << files << " files (" << std::fixed << std::setprecision(0)
-              << seconds << " s) -> " << templates.classes.size() << " classes in " << o.output << '\n';
+              << seconds << " s) -> " << templates.classes.size() << " classes in " << o.output
+              << '\n';
     for (const auto& c : set.classes())
         if (trainer.frames(c.name) < o.training.minFramesPerCluster && c.name != "sil")
             std::cerr << "lipsync train: note: class '" << c.name << "' has only "
@@ -55,19 +55,26 @@ void addTrainCommand(CLI::App& app) {
     auto o = std::make_shared<TrainOptions>();
     auto* cmd = app.add_subcommand(
         "train", "Train spectral templates from labelled audio (NAME.wav + NAME.lab folders)");
-    cmd->add_option("corpus", o->corpora, "Folders of NAME.wav + NAME.lab")->required()->check(CLI::ExistingDirectory);
+    cmd->add_option("corpus", o->corpora, "Folders of NAME.wav + NAME.lab")
+        ->required()
+        ->check(CLI::ExistingDirectory);
     cmd->add_option("-o,--output", o->output, "Template file to write (JSON)")->required();
-    cmd->add_option("--labels", o->labels, "Label alphabet: auto, common, arpabet, or a map name/file")
+    cmd->add_option("--labels", o->labels,
+                    "Label alphabet: auto, common, arpabet, or a map name/file")
         ->capture_default_str();
     cmd->add_option("--clusters", o->training.clustersPerClass, "Cluster means per class")
-        ->check(CLI::Range(1, 64))->capture_default_str();
+        ->check(CLI::Range(1, 64))
+        ->capture_default_str();
     cmd->add_option("--order", o->training.analysis.order, "LPC order")
-        ->check(CLI::Range(2, dsp::kMaxOrder))->capture_default_str();
+        ->check(CLI::Range(2, dsp::kMaxOrder))
+        ->capture_default_str();
     cmd->add_option("--bins", o->training.analysis.spectrumBins, "Spectrum points 0..rate/2")
-        ->check(CLI::Range(4, 512))->capture_default_str();
+        ->check(CLI::Range(4, 512))
+        ->capture_default_str();
     cmd->add_option("--extra-features", o->extraFeatures,
                     "Features after the spectrum: log_error, level (comma list, or 'none')")
-        ->delimiter(',')->capture_default_str();
+        ->delimiter(',')
+        ->capture_default_str();
     cmd->add_option("--description", o->description, "Description stored in the file");
     cmd->callback([o] {
         auto& a = o->training.analysis;
@@ -78,7 +85,9 @@ void addTrainCommand(CLI::App& app) {
             else if (f == "level")
                 a.levelFeature = true;
             else if (f != "none")
-                throw CLI::ValidationError("--extra-features", "unknown feature '" + f + "' (known: log_error, level, none)");
+                throw CLI::ValidationError(
+                    "--extra-features",
+                    "unknown feature '" + f + "' (known: log_error, level, none)");
         }
         runTrain(*o);
     });

@@ -1,9 +1,8 @@
 // lipsync: the command-line tool. Exit codes: 0 ok, 1 runtime error, 2 usage error.
-#include "Commands.hpp"
-
+#include <iostream>
 #include <lipsyncd/core.hpp>
 
-#include <iostream>
+#include "Commands.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{

@@ -1,12 +1,11 @@
 // Pose weights as CSV (DESIGN.md "File formats"): header `time,<pose>,...`, a row per frame.
-#include <lipsyncd/core.hpp>
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <lipsyncd/core.hpp>
 
 namespace lipsyncd {
 
@@ -30,7 +29,8 @@ std::vector<std::string_view> splitCsv(std::string_view line) {
     std::size_t start = 0;
     for (;;) {
         const auto comma = line.find(',', start);
-        auto field = line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
+        auto field =
+            line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
         while (!field.empty() && field.front() == ' ') field.remove_prefix(1);
         while (!field.empty() && field.back() == ' ') field.remove_suffix(1);
         out.push_back(field);
@@ -44,8 +44,8 @@ double parseNumber(std::string_view text, const std::string& source, std::size_t
     double v = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (ec != std::errc() || end != text.data() + text.size())
-        throw InputError(source, line, "column '" + column + "': '" + std::string(text) +
-                                           "' is not a number");
+        throw InputError(source, line,
+                         "column '" + column + "': '" + std::string(text) + "' is not a number");
     return v;
 }
 }  // namespace
@@ -61,7 +61,8 @@ PoseTrack readPoseTrackCsv(std::istream& in, const std::string& sourceName) {
         throw InputError(sourceName, 1, "header must start with 'time' (time,<pose>,<pose>,...)");
     if (header.size() < 2) throw InputError(sourceName, 1, "header names no poses");
     for (std::size_t i = 1; i < header.size(); ++i) {
-        if (header[i].empty()) throw InputError(sourceName, 1, "empty pose name in column " + std::to_string(i + 1));
+        if (header[i].empty())
+            throw InputError(sourceName, 1, "empty pose name in column " + std::to_string(i + 1));
         if (track.pose(header[i]))
             throw InputError(sourceName, 1, "pose '" + std::string(header[i]) + "' appears twice");
         track.poses.emplace_back(header[i]);
@@ -72,16 +73,18 @@ PoseTrack readPoseTrackCsv(std::istream& in, const std::string& sourceName) {
         if (text.empty() || text == "\r") continue;
         const auto fields = splitCsv(text);
         if (fields.size() != header.size())
-            throw InputError(sourceName, lineNo, "expected " + std::to_string(header.size()) +
-                                                     " columns, found " + std::to_string(fields.size()));
+            throw InputError(sourceName, lineNo,
+                             "expected " + std::to_string(header.size()) + " columns, found " +
+                                 std::to_string(fields.size()));
         const double t = parseNumber(fields[0], sourceName, lineNo, "time");
         if (!std::isfinite(t) || t < 0)
             throw InputError(sourceName, lineNo, "time must be a finite, non-negative number");
         if (!track.times.empty() && t <= track.times.back())
-            throw InputError(sourceName, lineNo, "time " + std::string(fields[0]) +
-                                                     " does not increase");
+            throw InputError(sourceName, lineNo,
+                             "time " + std::string(fields[0]) + " does not increase");
         for (std::size_t p = 0; p < row.size(); ++p)
-            row[p] = static_cast<float>(parseNumber(fields[p + 1], sourceName, lineNo, track.poses[p]));
+            row[p] =
+                static_cast<float>(parseNumber(fields[p + 1], sourceName, lineNo, track.poses[p]));
         track.append(t, row);
     }
     return track;

@@ -1,6 +1,5 @@
-#include <lipsyncd/dsp.hpp>
-
 #include <cmath>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
 

@@ -1,12 +1,11 @@
 // Decoding with libsndfile: files by content, raw PCM by description, stdin for pipes.
-#include <lipsyncd/dsp.hpp>
-
 #include <sndfile.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <unistd.h>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
 
@@ -104,10 +103,18 @@ AudioDecoder AudioDecoder::open(const std::filesystem::path& file, const DecodeO
     return AudioDecoder(std::move(s));
 }
 
-int AudioDecoder::sampleRate() const { return state_->info.samplerate; }
-int AudioDecoder::channels() const { return state_->info.channels; }
-const std::string& AudioDecoder::name() const { return state_->name; }
-std::int64_t AudioDecoder::nonFiniteSamples() const { return state_->nonFinite; }
+int AudioDecoder::sampleRate() const {
+    return state_->info.samplerate;
+}
+int AudioDecoder::channels() const {
+    return state_->info.channels;
+}
+const std::string& AudioDecoder::name() const {
+    return state_->name;
+}
+std::int64_t AudioDecoder::nonFiniteSamples() const {
+    return state_->nonFinite;
+}
 
 std::optional<std::int64_t> AudioDecoder::frames() const {
     const bool seekable = state_->info.seekable && state_->name != "<stdin>";
@@ -120,7 +127,8 @@ std::size_t AudioDecoder::read(std::span<float> out) {
     auto& s = *state_;
     const auto channels = static_cast<std::size_t>(s.info.channels);
     const std::size_t want = std::min(out.size(), kBlockFrames);
-    const auto got = sf_readf_float(s.file.get(), s.interleaved.data(), static_cast<sf_count_t>(want));
+    const auto got =
+        sf_readf_float(s.file.get(), s.interleaved.data(), static_cast<sf_count_t>(want));
     if (got < 0) throw InputError(s.name + ": read error (" + sf_strerror(s.file.get()) + ")");
     const auto n = static_cast<std::size_t>(got);
     for (std::size_t i = 0; i < n; ++i) {

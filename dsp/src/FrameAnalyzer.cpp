@@ -1,14 +1,13 @@
 // One analysis frame, in the order of Lewis's "linear prediction speech model" section and
 // codec2's lpc.c: pre-emphasis, window, autocorrelation, regularisation, Levinson–Durbin,
 // spectrum. The regularisation constants follow shared/notes/dsp.md.
-#include <lipsyncd/dsp.hpp>
-
-#include "LpcSpectrum.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <lipsyncd/dsp.hpp>
 #include <numbers>
+
+#include "LpcSpectrum.hpp"
 
 namespace lipsyncd::dsp {
 
@@ -28,7 +27,7 @@ FrameAnalyzer::FrameAnalyzer(const AnalysisConfig& config) : config_(config) {
     const int n = config_.windowSamples();
     window_.resize(n);
     buffer_.assign(static_cast<std::size_t>(n) + kMaxOrder, 0.0f);  // kMaxOrder leading zeros
-    for (int i = 0; i < n; ++i)  // Hamming
+    for (int i = 0; i < n; ++i)                                     // Hamming
         window_[i] = static_cast<float>(0.54 - 0.46 * std::cos(2 * std::numbers::pi * i / (n - 1)));
     // Gaussian lag window w[i] = exp(−½(2π·f0·i/fs)²): smooths the spectrum by f0 Hz, so
     // pitch harmonics do not pull the formant peaks (Lewis's "pitch contamination").
@@ -84,7 +83,8 @@ namespace {
 #endif
 
 template <int Lags>
-LIPSYNCD_VECTOR_CLONES void autocorrelateLags(const float* x, std::size_t n, std::array<float, kMaxOrder + 1>& r) {
+LIPSYNCD_VECTOR_CLONES void autocorrelateLags(const float* x, std::size_t n,
+                                              std::array<float, kMaxOrder + 1>& r) {
     std::array<float, Lags> acc{};
     for (std::size_t i = 0; i < n; ++i) {
         const float* past = x + i - (Lags - 1);  // past[Lags - 1 - lag] == x[i - lag]
@@ -126,7 +126,8 @@ void FrameAnalyzer::analyze(std::span<const float> frame, FrameFeatures& out) {
 
     out.lpc = levinsonDurbin(std::span<const float>(r_.data(), p + 1), p);
     out.normalizedError = out.lpc.normalizedError;
-    out.valid = out.energyDb > kSilentFrameDb && out.lpc.stable && std::isfinite(out.normalizedError);
+    out.valid =
+        out.energyDb > kSilentFrameDb && out.lpc.stable && std::isfinite(out.normalizedError);
     const auto bins = static_cast<std::size_t>(config_.spectrumBins);
     const auto spectrum = std::span<float>(out.spectrum).first(bins);
     if (!out.valid)  // a flat spectrum: the classifier sees "nothing", the gate calls it silence
@@ -141,10 +142,12 @@ void FrameAnalyzer::analyze(std::span<const float> frame, FrameFeatures& out) {
 void FrameAnalyzer::addExtraFeatures(FrameFeatures& out) {
     std::size_t at = static_cast<std::size_t>(config_.spectrumBins);
     if (config_.errorFeature)
-        out.spectrum[at++] = out.valid ? std::max(-40.0f, 10.0f * std::log10(out.normalizedError)) : 0.0f;
+        out.spectrum[at++] =
+            out.valid ? std::max(-40.0f, 10.0f * std::log10(out.normalizedError)) : 0.0f;
     if (config_.levelFeature) {
         // The peak follows loud frames at once and decays slowly through quiet ones.
-        const auto decay = static_cast<float>(config_.levelPeakDecayDbPerSecond * config_.hopSeconds);
+        const auto decay =
+            static_cast<float>(config_.levelPeakDecayDbPerSecond * config_.hopSeconds);
         peakDb_ = std::max(out.energyDb, peakDb_ - decay);
         out.spectrum[at++] = std::max(-60.0f, out.energyDb - peakDb_);
     }

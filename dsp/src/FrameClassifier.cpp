@@ -3,12 +3,11 @@
 // per bin by inverse variance (Tohkura 1987; shared/notes/dsp.md), an energy gate over an
 // adaptive noise floor for silence, and voicing from the normalised prediction error (Lewis:
 // "normalized errors greater than about 0.1 typically reflect consonants").
-#include <lipsyncd/dsp.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
 
@@ -29,7 +28,8 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
     for (std::size_t b = 0; b < features_; ++b) scale_[b] = std::sqrt(templates.binWeights[b]);
     for (const auto& c : templates.classes) {
         const auto idx = set.find(c.phoneme);
-        if (!idx) throw InputError("templates: class '" + c.phoneme + "' is not in the phoneme set");
+        if (!idx)
+            throw InputError("templates: class '" + c.phoneme + "' is not in the phoneme set");
         for (const auto& t : c.spectra) {
             rowClass_.push_back(static_cast<int>(*idx));
             for (std::size_t b = 0; b < width_; ++b)
@@ -65,7 +65,8 @@ void squaredDistances(const float* x, const float* matrix, std::size_t rows, std
                 const float d = x[i + k] - matrix[i + k];
                 acc[k] += d * d;
             }
-        out[row] = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+        out[row] =
+            ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
     }
 }
 }  // namespace
@@ -83,8 +84,9 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
     if (frame.energyDb < noiseFloorDb_)
         noiseFloorDb_ = frame.energyDb;
     else
-        noiseFloorDb_ = std::min(kMaxNoiseFloorDb,
-                                 noiseFloorDb_ + config_.noiseFloorRiseDbPerSecond * static_cast<float>(dt));
+        noiseFloorDb_ =
+            std::min(kMaxNoiseFloorDb,
+                     noiseFloorDb_ + config_.noiseFloorRiseDbPerSecond * static_cast<float>(dt));
     label.noiseFloorDb = noiseFloorDb_;
     const float gate = std::max(config_.absoluteSilenceDb, noiseFloorDb_ + config_.silenceMarginDb);
 
@@ -98,7 +100,8 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         return label;
     }
     for (std::size_t b = 0; b < features_; ++b) scaledFrame_[b] = frame.spectrum[b] * scale_[b];
-    squaredDistances(scaledFrame_.data(), matrix_.data(), rowClass_.size(), width_, rowDistances_.data());
+    squaredDistances(scaledFrame_.data(), matrix_.data(), rowClass_.size(), width_,
+                     rowDistances_.data());
     for (std::size_t row = 0; row < rowClass_.size(); ++row) {
         float& slot = distances_[static_cast<std::size_t>(rowClass_[row])];
         slot = std::min(slot, rowDistances_[row]);
@@ -134,7 +137,8 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         label.runnerUpDistance = label.distance;
         label.phoneme = sil;
         // Sure when far below the gate, unsure near it.
-        label.confidence = std::clamp((gate - frame.energyDb) / config_.silenceMarginDb, 0.0f, 1.0f);
+        label.confidence =
+            std::clamp((gate - frame.energyDb) / config_.silenceMarginDb, 0.0f, 1.0f);
     }
     return label;
 }

@@ -1,9 +1,8 @@
 // Resample to the analysis rate and cut a frame every hop. Buffers are sized at construction;
 // push() does not allocate.
-#include <lipsyncd/dsp.hpp>
-
 #include <algorithm>
 #include <cstring>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
 
@@ -20,7 +19,9 @@ FrameStream::FrameStream(const AnalysisConfig& config, double inputRate, Resampl
     buffer_.assign(window + maxOut, 0.0f);
 }
 
-double FrameStream::endTime() const { return endTime_; }
+double FrameStream::endTime() const {
+    return endTime_;
+}
 
 void FrameStream::analyzeReadyFrames(const Sink& sink) {
     const auto& c = analyzer_.config();
@@ -29,13 +30,15 @@ void FrameStream::analyzeReadyFrames(const Sink& sink) {
     while (nextFrameStart_ + window <= produced_) {
         const auto offset = static_cast<std::size_t>(nextFrameStart_ - consumed_);
         features_.time = (static_cast<double>(nextFrameStart_) + window / 2.0) / c.analysisRate;
-        analyzer_.analyze(std::span<const float>(buffer_.data() + offset, static_cast<std::size_t>(window)),
-                          features_);
+        analyzer_.analyze(
+            std::span<const float>(buffer_.data() + offset, static_cast<std::size_t>(window)),
+            features_);
         sink(features_);
         nextFrameStart_ += hop;
     }
     // Drop what no later frame needs.
-    const auto keepFrom = static_cast<std::size_t>(std::max<std::int64_t>(0, nextFrameStart_ - consumed_));
+    const auto keepFrom =
+        static_cast<std::size_t>(std::max<std::int64_t>(0, nextFrameStart_ - consumed_));
     const std::size_t drop = std::min(keepFrom, fill_);
     if (drop > 0) {
         std::memmove(buffer_.data(), buffer_.data() + drop, (fill_ - drop) * sizeof(float));
@@ -72,18 +75,21 @@ void FrameStream::finish(const Sink& sink) {
     }
     endTime_ = static_cast<double>(produced_) / analyzer_.config().analysisRate;
     // Half a window of silence lets every frame centred inside the audio be analysed.
-    const std::vector<float> padding(static_cast<std::size_t>(analyzer_.config().windowSamples() / 2), 0.0f);
+    const std::vector<float> padding(
+        static_cast<std::size_t>(analyzer_.config().windowSamples() / 2), 0.0f);
     append(padding, sink);
 }
 
 std::vector<FrameFeatures> analyzeFrames(const std::filesystem::path& file,
-                                         const AnalysisConfig& config, const DecodeOptions& decode) {
+                                         const AnalysisConfig& config,
+                                         const DecodeOptions& decode) {
     auto decoder = AudioDecoder::open(file, decode);
     FrameStream stream(config, decoder.sampleRate());
     std::vector<FrameFeatures> frames;
     const FrameStream::Sink keep = [&](const FrameFeatures& f) { frames.push_back(f); };
     std::vector<float> block(kMaxInputBlock);
-    while (const auto n = decoder.read(block)) stream.push(std::span<const float>(block.data(), n), keep);
+    while (const auto n = decoder.read(block))
+        stream.push(std::span<const float>(block.data(), n), keep);
     stream.finish(keep);
     return frames;
 }

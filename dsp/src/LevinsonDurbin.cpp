@@ -5,9 +5,8 @@
 // Convention: A(z) = 1 + Σ a[i] z^-i is the inverse (whitening) filter, so the predictor is
 // x̂[n] = −Σ a[i] x[n−i]. k[i] is the reflection coefficient of step i in the same sign
 // convention (k[i] = a_i^(i)); the PARCOR coefficients of some texts are −k.
-#include <lipsyncd/dsp.hpp>
-
 #include <cmath>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
 

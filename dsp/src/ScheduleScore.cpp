@@ -12,12 +12,14 @@ void ScheduleScore::add(const ScheduleScore& other) {
         return;
     }
     for (std::size_t r = 0; r < confusion.size() && r < other.confusion.size(); ++r)
-        for (std::size_t h = 0; h < confusion[r].size(); ++h) confusion[r][h] += other.confusion[r][h];
+        for (std::size_t h = 0; h < confusion[r].size(); ++h)
+            confusion[r][h] += other.confusion[r][h];
 }
 
 namespace {
 // The class of the segment covering time t, walking forward with a cursor.
-std::size_t classAt(const PhonemeSchedule& s, double t, std::size_t& cursor, const PhonemeSet& set) {
+std::size_t classAt(const PhonemeSchedule& s, double t, std::size_t& cursor,
+                    const PhonemeSet& set) {
     while (cursor < s.size() && s[cursor].end <= t) ++cursor;
     if (cursor >= s.size() || s[cursor].start > t) return set.silence();
     return set.find(s[cursor].phoneme).value_or(set.silence());

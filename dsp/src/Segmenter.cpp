@@ -3,9 +3,8 @@
 // made viseme changes "markedly more natural"; phonemes need less). A run is final once the
 // run after it has reached its own minimum length: nothing later can then move the boundary
 // between them, so the delay is bounded by the longest minimum plus one hop.
-#include <lipsyncd/dsp.hpp>
-
 #include <algorithm>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
 
@@ -18,12 +17,12 @@ Segmenter::Segmenter(const PhonemeSet& set, double hopSeconds, const SegmenterCo
 double Segmenter::minDuration(int phoneme) const {
     if (phoneme == static_cast<int>(set_->silence())) return config_.minSilenceSeconds;
     return (*set_)[static_cast<std::size_t>(phoneme)].vowel ? config_.minVowelSeconds
-                                                             : config_.minConsonantSeconds;
+                                                            : config_.minConsonantSeconds;
 }
 
 double Segmenter::delaySeconds() const {
-    return std::max({config_.minVowelSeconds, config_.minConsonantSeconds,
-                     config_.minSilenceSeconds}) +
+    return std::max(
+               {config_.minVowelSeconds, config_.minConsonantSeconds, config_.minSilenceSeconds}) +
            hop_;
 }
 

@@ -1,11 +1,10 @@
 // Streaming sample-rate conversion with libsoxr (the fastest resampler in Debian 12 by a wide
 // margin: shared/notes/dsp.md). Allocates only here at setup; process() reuses its buffer.
-#include <lipsyncd/dsp.hpp>
-
 #include <soxr.h>
 
 #include <algorithm>
 #include <cmath>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
 
@@ -30,7 +29,8 @@ double measureHeldBack(double inputRate, double outputRate, ResamplerQuality qua
     soxr_t probe = createSoxr(inputRate, outputRate, quality);
     const auto block = static_cast<std::size_t>(std::max(1.0, std::round(inputRate / 100)));
     std::vector<float> in(block, 0.0f);
-    std::vector<float> out(static_cast<std::size_t>(std::ceil(block * outputRate / inputRate)) + 4096);
+    std::vector<float> out(static_cast<std::size_t>(std::ceil(block * outputRate / inputRate)) +
+                           4096);
     double fed = 0, made = 0, worst = 0;
     for (int i = 0; i < 200; ++i) {
         size_t used = 0, produced = 0;
@@ -47,10 +47,14 @@ unsigned long soxrRecipe(ResamplerQuality q) {
     switch (q) {
         // The live preset: phase does not matter to an LPC magnitude spectrum, and minimum
         // phase releases the impulse response's energy sooner.
-        case ResamplerQuality::Low: return SOXR_LQ | SOXR_MINIMUM_PHASE;
-        case ResamplerQuality::Medium: return SOXR_MQ;
-        case ResamplerQuality::High: return SOXR_HQ;
-        case ResamplerQuality::VeryHigh: return SOXR_VHQ;
+        case ResamplerQuality::Low:
+            return SOXR_LQ | SOXR_MINIMUM_PHASE;
+        case ResamplerQuality::Medium:
+            return SOXR_MQ;
+        case ResamplerQuality::High:
+            return SOXR_HQ;
+        case ResamplerQuality::VeryHigh:
+            return SOXR_VHQ;
     }
     return SOXR_MQ;
 }
@@ -94,10 +98,10 @@ std::span<const float> StreamResampler::process(std::span<const float> input, bo
     size_t used = 0, made = 0;
     // soxr takes a null input pointer as "end of input": it then drains its filter.
     const float* in = flush && input.empty() ? nullptr : input.data();
-    const auto err = soxr_process(s.soxr, in, input.size(), &used, s.out.data(), s.out.size(), &made);
+    const auto err =
+        soxr_process(s.soxr, in, input.size(), &used, s.out.data(), s.out.size(), &made);
     if (err) throw std::runtime_error(std::string("libsoxr: ") + err);
     return {s.out.data(), made};
 }
-
 
 }  // namespace lipsyncd::dsp

@@ -42,7 +42,9 @@ void StreamingAnalyzer::onFeatures(const FrameFeatures& features) {
         if (segmentSink_) segmentSink_(seg);
 }
 
-void StreamingAnalyzer::push(std::span<const float> samples) { frames_.push(samples, featureSink_); }
+void StreamingAnalyzer::push(std::span<const float> samples) {
+    frames_.push(samples, featureSink_);
+}
 
 void StreamingAnalyzer::finish() {
     frames_.finish(featureSink_);

@@ -1,10 +1,8 @@
 // Spectral templates as data: JSON under config/templates/ (format in its README.md).
-#include <lipsyncd/dsp.hpp>
-
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <fstream>
+#include <lipsyncd/dsp.hpp>
+#include <nlohmann/json.hpp>
 
 namespace lipsyncd::dsp {
 
@@ -15,14 +13,16 @@ constexpr int kVersion = 1;
 
 // Reads a member with a message naming the JSON path when it is missing or of the wrong type.
 template <typename T>
-T member(const json& j, const std::string& key, const std::string& path, const std::string& source) {
+T member(const json& j, const std::string& key, const std::string& path,
+         const std::string& source) {
     if (!j.is_object() || !j.contains(key))
         throw InputError(source, 0, "missing field '" + path + key + "'");
     try {
         return j.at(key).get<T>();
     } catch (const json::exception&) {
-        throw InputError(source, 0, "field '" + path + key + "' has the wrong type (" +
-                                        std::string(j.at(key).type_name()) + ")");
+        throw InputError(source, 0,
+                         "field '" + path + key + "' has the wrong type (" +
+                             std::string(j.at(key).type_name()) + ")");
     }
 }
 
@@ -45,10 +45,12 @@ AnalysisConfig readAnalysis(const json& a, const std::string& source) {
             else if (name == "level")
                 c.levelFeature = true;
             else
-                throw InputError(source, 0, "analysis.extra_features: unknown feature '" + name +
-                                                "' (known: log_error, level)");
+                throw InputError(source, 0,
+                                 "analysis.extra_features: unknown feature '" + name +
+                                     "' (known: log_error, level)");
         }
-        if (c.levelFeature) c.levelPeakDecayDbPerSecond = member<double>(a, "level_peak_decay", p, source);
+        if (c.levelFeature)
+            c.levelPeakDecayDbPerSecond = member<double>(a, "level_peak_decay", p, source);
     }
     try {
         c.validate();
@@ -59,11 +61,14 @@ AnalysisConfig readAnalysis(const json& a, const std::string& source) {
 }
 
 json writeAnalysis(const AnalysisConfig& c) {
-    json a = {{"rate", c.analysisRate},         {"hop", c.hopSeconds},
-            {"window", c.windowSeconds},      {"order", c.order},
-            {"pre_emphasis", c.preEmphasis},  {"lag_window_hz", c.lagWindowHz},
-            {"white_noise_correction", c.whiteNoiseCorrection},
-            {"bins", c.spectrumBins}};
+    json a = {{"rate", c.analysisRate},
+              {"hop", c.hopSeconds},
+              {"window", c.windowSeconds},
+              {"order", c.order},
+              {"pre_emphasis", c.preEmphasis},
+              {"lag_window_hz", c.lagWindowHz},
+              {"white_noise_correction", c.whiteNoiseCorrection},
+              {"bins", c.spectrumBins}};
     auto& extra = a["extra_features"] = json::array();
     if (c.errorFeature) extra.push_back("log_error");
     if (c.levelFeature) {
@@ -77,7 +82,8 @@ json writeAnalysis(const AnalysisConfig& c) {
 // shows 1.034 rather than the float's 1.034000039100647.
 std::vector<double> rounded(const std::vector<float>& v) {
     std::vector<double> out(v.size());
-    for (std::size_t i = 0; i < v.size(); ++i) out[i] = std::round(static_cast<double>(v[i]) * 1000.0) / 1000.0;
+    for (std::size_t i = 0; i < v.size(); ++i)
+        out[i] = std::round(static_cast<double>(v[i]) * 1000.0) / 1000.0;
     return out;
 }
 }  // namespace
@@ -86,9 +92,9 @@ void TemplateSet::validate(const std::string& source) const {
     // One weight and one template value per feature: the spectrum's bins, then the extras.
     const auto bins = static_cast<std::size_t>(analysis.featureCount());
     if (binWeights.size() != bins)
-        throw InputError(source, 0, "bin_weights has " + std::to_string(binWeights.size()) +
-                                        " values, the analysis has " + std::to_string(bins) +
-                                        " features");
+        throw InputError(source, 0,
+                         "bin_weights has " + std::to_string(binWeights.size()) +
+                             " values, the analysis has " + std::to_string(bins) + " features");
     for (std::size_t b = 0; b < bins; ++b)
         if (!(binWeights[b] >= 0) || !std::isfinite(binWeights[b]))
             throw InputError(source, 0, "bin_weights[" + std::to_string(b) + "] must be >= 0");
@@ -105,13 +111,15 @@ void TemplateSet::validate(const std::string& source) const {
         if (cls.spectra.empty()) throw InputError(source, 0, where + ": no spectra");
         for (std::size_t s = 0; s < cls.spectra.size(); ++s) {
             if (cls.spectra[s].size() != bins)
-                throw InputError(source, 0, where + ".spectra[" + std::to_string(s) + "] has " +
-                                                std::to_string(cls.spectra[s].size()) +
-                                                " values, expected " + std::to_string(bins));
+                throw InputError(source, 0,
+                                 where + ".spectra[" + std::to_string(s) + "] has " +
+                                     std::to_string(cls.spectra[s].size()) + " values, expected " +
+                                     std::to_string(bins));
             for (float v : cls.spectra[s])
                 if (!std::isfinite(v) || std::abs(v) > 200)
-                    throw InputError(source, 0, where + ".spectra[" + std::to_string(s) +
-                                                    "]: values must be finite dB within ±200");
+                    throw InputError(source, 0,
+                                     where + ".spectra[" + std::to_string(s) +
+                                         "]: values must be finite dB within ±200");
         }
     }
 }
@@ -129,9 +137,10 @@ TemplateSet TemplateSet::load(const std::filesystem::path& file) {
     if (member<std::string>(j, "format", "", source) != kFormat)
         throw InputError(source, 0, std::string("field 'format' must be \"") + kFormat + "\"");
     if (const int v = member<int>(j, "version", "", source); v != kVersion)
-        throw InputError(source, 0, "template format version " + std::to_string(v) +
-                                        " is not supported (this build reads " +
-                                        std::to_string(kVersion) + ")");
+        throw InputError(source, 0,
+                         "template format version " + std::to_string(v) +
+                             " is not supported (this build reads " + std::to_string(kVersion) +
+                             ")");
     TemplateSet t;
     t.description = j.value("description", "");
     t.analysis = readAnalysis(member<json>(j, "analysis", "", source), source);
@@ -150,7 +159,9 @@ TemplateSet TemplateSet::load(const std::filesystem::path& file) {
     return t;
 }
 
-TemplateSet TemplateSet::loadDefault() { return load(findDataFile("templates/default.json")); }
+TemplateSet TemplateSet::loadDefault() {
+    return load(findDataFile("templates/default.json"));
+}
 
 void TemplateSet::save(const std::filesystem::path& file) const {
     validate(file.string());

@@ -1,9 +1,8 @@
 // Template training: cluster means per class (paper 001, section 4, applied to LPC spectra).
-#include <lipsyncd/dsp.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <lipsyncd/dsp.hpp>
 #include <numeric>
 #include <random>
 
@@ -30,12 +29,14 @@ Spectrum mean(const std::vector<const Spectrum*>& members, std::size_t bins) {
 std::vector<Spectrum> kMeans(const std::vector<Spectrum>& points, int k, std::uint32_t seed) {
     const std::size_t bins = points.front().size();
     std::mt19937 rng(seed);
-    std::vector<Spectrum> centres{points[std::uniform_int_distribution<std::size_t>(0, points.size() - 1)(rng)]};
+    std::vector<Spectrum> centres{
+        points[std::uniform_int_distribution<std::size_t>(0, points.size() - 1)(rng)]};
     std::vector<float> nearest(points.size());
     while (static_cast<int>(centres.size()) < k) {
         for (std::size_t i = 0; i < points.size(); ++i) {
             nearest[i] = std::numeric_limits<float>::max();
-            for (const auto& c : centres) nearest[i] = std::min(nearest[i], squaredDistance(points[i], c));
+            for (const auto& c : centres)
+                nearest[i] = std::min(nearest[i], squaredDistance(points[i], c));
         }
         std::discrete_distribution<std::size_t> pick(nearest.begin(), nearest.end());
         centres.push_back(points[pick(rng)]);
@@ -46,7 +47,9 @@ std::vector<Spectrum> kMeans(const std::vector<Spectrum>& points, int k, std::ui
         for (std::size_t i = 0; i < points.size(); ++i) {
             int best = 0;
             for (int c = 1; c < k; ++c)
-                if (squaredDistance(points[i], centres[c]) < squaredDistance(points[i], centres[best])) best = c;
+                if (squaredDistance(points[i], centres[c]) <
+                    squaredDistance(points[i], centres[best]))
+                    best = c;
             changed |= assignment[i] != best;
             assignment[i] = best;
         }
@@ -71,7 +74,8 @@ void TemplateTrainer::addFrame(const FrameFeatures& frame, std::size_t phoneme) 
     spectra_[phoneme].push_back(frame.spectrum);
 }
 
-void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames, const PhonemeSchedule& labels) {
+void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames,
+                                   const PhonemeSchedule& labels) {
     float peak = -120;
     for (const auto& f : frames) peak = std::max(peak, f.energyDb);
     std::size_t seg = 0;
@@ -84,14 +88,16 @@ void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames, const 
         // Transitions belong to neither neighbour; keep frames well inside a segment (short
         // segments keep their middle frame).
         const bool inside = f.time - label.start >= margin && label.end - f.time >= margin;
-        const bool middle = std::abs(f.time - 0.5 * (label.start + label.end)) <= 0.5 * options_.analysis.hopSeconds;
+        const bool middle = std::abs(f.time - 0.5 * (label.start + label.end)) <=
+                            0.5 * options_.analysis.hopSeconds;
         if (!inside && !middle) continue;
         if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb) continue;
         if (const auto cls = set_->find(label.phoneme)) addFrame(f, *cls);
     }
 }
 
-void TemplateTrainer::addSustained(std::span<const FrameFeatures> frames, const std::string& phoneme) {
+void TemplateTrainer::addSustained(std::span<const FrameFeatures> frames,
+                                   const std::string& phoneme) {
     const auto cls = set_->find(phoneme);
     if (!cls) throw InputError("'" + phoneme + "' is not a phoneme class");
     float peak = -120;
@@ -127,8 +133,9 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
         TemplateSet::ClassTemplates cls;
         cls.phoneme = (*set_)[c].name;
         cls.frames = frames.size();
-        const int k = static_cast<int>(std::clamp<std::size_t>(
-            frames.size() / options_.minFramesPerCluster, 1, static_cast<std::size_t>(options_.clustersPerClass)));
+        const int k = static_cast<int>(
+            std::clamp<std::size_t>(frames.size() / options_.minFramesPerCluster, 1,
+                                    static_cast<std::size_t>(options_.clustersPerClass)));
         cls.spectra = kMeans(frames, k, options_.seed + static_cast<std::uint32_t>(c));
         t.classes.push_back(std::move(cls));
     }

@@ -1,14 +1,13 @@
 // The `lipsync` tool as a user meets it: help, version, exit codes (0 ok, 1 runtime error,
 // 2 usage error), and errors on stderr that name the file and what is wrong.
-#include "RunLipsync.hpp"
-
-#include <lipsyncd/core.hpp>
-#include <lipsyncd/dsp.hpp>
-
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <lipsyncd/core.hpp>
+#include <lipsyncd/dsp.hpp>
+
+#include "RunLipsync.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -75,8 +74,8 @@ TEST(LipsyncCli, NonAudioBytesNameTheFile) {
 TEST(LipsyncCli, AnalyzeWritesAScheduleThatReadsBack) {
     const auto out = scratchDir("cli_analyze") / "hello.tsv";
     const auto frames = out.parent_path() / "frames.csv";
-    const auto r = runLipsync({"analyze", exampleWav().string(), "-s", out.string(), "--frames",
-                               frames.string(), "-q"});
+    const auto r = runLipsync(
+        {"analyze", exampleWav().string(), "-s", out.string(), "--frames", frames.string(), "-q"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto schedule = readScheduleFile(out);
     ASSERT_GT(schedule.size(), 5u);
@@ -118,8 +117,11 @@ TEST(LipsyncCli, EvalOnAFolderWithoutLabelsSaysSo) {
 TEST(LipsyncCli, CalibrateBuildsLoadableTemplatesAndNamesStrayFiles) {
     const auto dir = scratchDir("cli_calibrate");
     // Sustained-ish sounds from espeak-ng stand in for a speaker's recordings.
-    for (const auto& [cls, text] : {std::pair{"aa", "ahhhhhh"}, {"ow", "ohhhhhh"}, {"sh", "shhhhhh"}})
-        ASSERT_EQ(runLipsync({"say", text, "--wav", (dir / (std::string(cls) + ".wav")).string()}).exitCode, 0);
+    for (const auto& [cls, text] :
+         {std::pair{"aa", "ahhhhhh"}, {"ow", "ohhhhhh"}, {"sh", "shhhhhh"}})
+        ASSERT_EQ(runLipsync({"say", text, "--wav", (dir / (std::string(cls) + ".wav")).string()})
+                      .exitCode,
+                  0);
     std::ofstream(dir / "hum.wav") << "x";
     const auto out = dir.parent_path() / "calibrated.json";
     const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string()});

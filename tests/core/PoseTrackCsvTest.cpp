@@ -1,8 +1,7 @@
-#include <lipsyncd/core.hpp>
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lipsyncd/core.hpp>
 #include <sstream>
 
 using namespace lipsyncd;

@@ -1,18 +1,18 @@
-#include <lipsyncd/dsp.hpp>
-
-#include "../../dsp/src/LpcSpectrum.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lipsyncd/dsp.hpp>
 #include <random>
+
+#include "../../dsp/src/LpcSpectrum.hpp"
 
 using namespace lipsyncd::dsp;
 
 namespace {
 std::vector<float> sine(double hz, int rate, int n, float amplitude = 0.5f) {
     std::vector<float> x(n);
-    for (int i = 0; i < n; ++i) x[i] = amplitude * static_cast<float>(std::sin(2 * M_PI * hz * i / rate));
+    for (int i = 0; i < n; ++i)
+        x[i] = amplitude * static_cast<float>(std::sin(2 * M_PI * hz * i / rate));
     return x;
 }
 }  // namespace

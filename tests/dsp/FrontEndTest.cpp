@@ -1,12 +1,12 @@
 // The whole front end: formats, rates and channels give the same schedule; streaming equals one
 // block; bad input is refused clearly or read correctly.
-#include "TestSpeech.hpp"
-
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <fstream>
-#include <sys/resource.h>
+
+#include "TestSpeech.hpp"
 
 using namespace lipsyncd;
 
@@ -43,8 +43,8 @@ double agreement(const PhonemeSchedule& a, const PhonemeSchedule& b) {
 
 TEST(FrontEnd, SameSpeechInAnyFormatRateOrLayoutGivesTheSameSchedule) {
     const auto& speech = test::testSpeech();
-    const auto reference = analyze(test::writeAudio("ref.wav", speech.samples, speech.rate,
-                                                    SF_FORMAT_WAV | SF_FORMAT_FLOAT));
+    const auto reference = analyze(
+        test::writeAudio("ref.wav", speech.samples, speech.rate, SF_FORMAT_WAV | SF_FORMAT_FLOAT));
     ASSERT_GT(reference.schedule.size(), 10u);
     struct Variant {
         const char* name;
@@ -77,14 +77,15 @@ TEST(FrontEnd, ChannelSelectionIgnoresTheOtherChannel) {
     const auto& speech = test::testSpeech();
     const auto file = test::writeAudio("show.wav", speech.samples, speech.rate,
                                        SF_FORMAT_WAV | SF_FORMAT_FLOAT, {1.0f, 1.0f});
-    const auto voiceOnly = test::writeAudio("voice.wav", speech.samples, speech.rate,
-                                            SF_FORMAT_WAV | SF_FORMAT_FLOAT);
+    const auto voiceOnly =
+        test::writeAudio("voice.wav", speech.samples, speech.rate, SF_FORMAT_WAV | SF_FORMAT_FLOAT);
     EXPECT_EQ(analyze(file, {0}).schedule, analyze(voiceOnly).schedule);
     try {
         analyze(file, {2});
         FAIL();
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("--channel 2 does not exist"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--channel 2 does not exist"), std::string::npos)
+            << e.what();
     }
 }
 
@@ -94,9 +95,13 @@ TEST(FrontEnd, StreamingInOddChunksGivesTheSameFramesAsOneBlock) {
     auto run = [&](std::size_t chunk) {
         dsp::FrameStream stream(config, speech.rate);
         std::vector<dsp::FrameFeatures> frames;
-        const dsp::FrameStream::Sink keep = [&](const dsp::FrameFeatures& f) { frames.push_back(f); };
+        const dsp::FrameStream::Sink keep = [&](const dsp::FrameFeatures& f) {
+            frames.push_back(f);
+        };
         for (std::size_t i = 0; i < speech.samples.size(); i += chunk)
-            stream.push(std::span<const float>(speech.samples).subspan(i, std::min(chunk, speech.samples.size() - i)), keep);
+            stream.push(std::span<const float>(speech.samples)
+                            .subspan(i, std::min(chunk, speech.samples.size() - i)),
+                        keep);
         stream.finish(keep);
         return frames;
     };
@@ -106,9 +111,11 @@ TEST(FrontEnd, StreamingInOddChunksGivesTheSameFramesAsOneBlock) {
         ASSERT_EQ(parts.size(), whole.size()) << "chunk " << chunk;
         for (std::size_t i = 0; i < whole.size(); ++i) {
             ASSERT_DOUBLE_EQ(parts[i].time, whole[i].time);
-            ASSERT_NEAR(parts[i].energyDb, whole[i].energyDb, 1e-3) << "chunk " << chunk << " frame " << i;
+            ASSERT_NEAR(parts[i].energyDb, whole[i].energyDb, 1e-3)
+                << "chunk " << chunk << " frame " << i;
             for (std::size_t b = 0; b < whole[i].spectrum.size(); ++b)
-                ASSERT_NEAR(parts[i].spectrum[b], whole[i].spectrum[b], 1e-2) << "chunk " << chunk << " frame " << i;
+                ASSERT_NEAR(parts[i].spectrum[b], whole[i].spectrum[b], 1e-2)
+                    << "chunk " << chunk << " frame " << i;
         }
     }
 }
@@ -136,10 +143,13 @@ TEST(FrontEnd, SegmentsCloseWithinTheReportedLatency) {
 TEST(FrontEnd, BadFilesGetClearErrors) {
     EXPECT_NE(errorOf("/nonexistent/x.wav").find("no such file"), std::string::npos);
     EXPECT_NE(errorOf(writeBytes("empty.wav", "")).find("cannot decode"), std::string::npos);
-    EXPECT_NE(errorOf(writeBytes("junk.wav", std::string(5000, 'x'))).find("cannot decode"), std::string::npos);
-    EXPECT_NE(errorOf(writeBytes("trunc.wav", "RIFF\x24\x00\x00\x00WAVEfmt ")).find("lipsyncd_test_trunc.wav"),
+    EXPECT_NE(errorOf(writeBytes("junk.wav", std::string(5000, 'x'))).find("cannot decode"),
               std::string::npos);
-    EXPECT_NE(errorOf(std::filesystem::temp_directory_path()).find("is a directory"), std::string::npos);
+    EXPECT_NE(errorOf(writeBytes("trunc.wav", "RIFF\x24\x00\x00\x00WAVEfmt "))
+                  .find("lipsyncd_test_trunc.wav"),
+              std::string::npos);
+    EXPECT_NE(errorOf(std::filesystem::temp_directory_path()).find("is a directory"),
+              std::string::npos);
 }
 
 TEST(FrontEnd, ZeroLengthAudioGivesAnEmptySchedule) {
@@ -151,7 +161,8 @@ TEST(FrontEnd, ZeroLengthAudioGivesAnEmptySchedule) {
 
 TEST(FrontEnd, TruncatedDataIsReadAsFarAsItGoes) {
     const auto& speech = test::testSpeech();
-    const auto file = test::writeAudio("cut.wav", speech.samples, speech.rate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+    const auto file =
+        test::writeAudio("cut.wav", speech.samples, speech.rate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
     std::filesystem::resize_file(file, std::filesystem::file_size(file) / 2);
     const auto result = analyze(file);
     EXPECT_NEAR(result.durationSeconds, speech.samples.size() / 2.0 / speech.rate, 0.01);
@@ -162,7 +173,8 @@ TEST(FrontEnd, NaNSamplesAreCountedAndReadAsSilence) {
     auto samples = test::testSpeech().samples;
     for (std::size_t i = 1000; i < 3000; ++i) samples[i] = std::nanf("");
     samples[5000] = INFINITY;
-    const auto file = test::writeAudio("nan.wav", samples, test::testSpeech().rate, SF_FORMAT_WAV | SF_FORMAT_FLOAT);
+    const auto file = test::writeAudio("nan.wav", samples, test::testSpeech().rate,
+                                       SF_FORMAT_WAV | SF_FORMAT_FLOAT);
     const auto result = analyze(file);
     EXPECT_EQ(result.nonFiniteSamples, 2001);
     for (const auto& s : result.schedule) {

@@ -1,8 +1,7 @@
-#include <lipsyncd/dsp.hpp>
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lipsyncd/dsp.hpp>
 #include <random>
 
 using namespace lipsyncd::dsp;
@@ -68,14 +67,16 @@ TEST(LevinsonDurbin, MatchesADirectSolveOfTheNormalEquations) {
         const auto direct = directSolve(r, p);
         ASSERT_TRUE(lpc.stable);
         ASSERT_EQ(lpc.order, p);
-        for (int i = 0; i < p; ++i) EXPECT_NEAR(lpc.a[i + 1], direct[i], 1e-3) << "a[" << i + 1 << "]";
+        for (int i = 0; i < p; ++i)
+            EXPECT_NEAR(lpc.a[i + 1], direct[i], 1e-3) << "a[" << i + 1 << "]";
     }
 }
 
 TEST(LevinsonDurbin, RecoversTheCoefficientsOfAKnownArProcess) {
     // Two resonances: poles at radius 0.95 (500 Hz) and 0.9 (1500 Hz) at 10 kHz.
     auto resonator = [](double radius, double hz) {
-        return std::vector<double>{1.0, -2 * radius * std::cos(2 * M_PI * hz / 10000), radius * radius};
+        return std::vector<double>{1.0, -2 * radius * std::cos(2 * M_PI * hz / 10000),
+                                   radius * radius};
     };
     const auto a1 = resonator(0.95, 500), a2 = resonator(0.9, 1500);
     std::vector<double> a(5, 0.0);

@@ -1,15 +1,16 @@
-#include "TestSpeech.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+
+#include "TestSpeech.hpp"
 
 using namespace lipsyncd;
 
 namespace {
 std::vector<float> tone(double hz, int rate, double seconds) {
     std::vector<float> x(static_cast<std::size_t>(rate * seconds));
-    for (std::size_t i = 0; i < x.size(); ++i) x[i] = 0.5f * static_cast<float>(std::sin(2 * M_PI * hz * i / rate));
+    for (std::size_t i = 0; i < x.size(); ++i)
+        x[i] = 0.5f * static_cast<float>(std::sin(2 * M_PI * hz * i / rate));
     return x;
 }
 
@@ -45,8 +46,10 @@ std::pair<double, double> impulseLatency(dsp::ResamplerQuality quality, std::siz
         const auto o = r.process(std::span<const float>(x).subspan(i, block));
         y.insert(y.end(), o.begin(), o.end());
         const auto peak = std::max_element(y.begin(), y.end());
-        if (measured < 0 && !y.empty() && *peak > 0.3f && std::size_t(peak - y.begin()) + 4 < y.size())
-            measured = static_cast<double>(i + block - impulse) / in;  // the peak is past, not at the edge
+        if (measured < 0 && !y.empty() && *peak > 0.3f &&
+            std::size_t(peak - y.begin()) + 4 < y.size())
+            measured =
+                static_cast<double>(i + block - impulse) / in;  // the peak is past, not at the edge
     }
     return {measured, static_cast<double>(std::max_element(y.begin(), y.end()) - y.begin()) / out};
 }

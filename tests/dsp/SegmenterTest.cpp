@@ -1,8 +1,7 @@
-#include <lipsyncd/dsp.hpp>
-
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <lipsyncd/dsp.hpp>
 
 using namespace lipsyncd;
 
@@ -23,7 +22,9 @@ PhonemeSchedule segment(const std::vector<std::string>& classes, dsp::SegmenterC
     return out;
 }
 
-std::vector<std::string> repeat(const std::string& c, int n) { return std::vector<std::string>(n, c); }
+std::vector<std::string> repeat(const std::string& c, int n) {
+    return std::vector<std::string>(n, c);
+}
 
 std::vector<std::string> concat(std::initializer_list<std::vector<std::string>> parts) {
     std::vector<std::string> out;
@@ -33,7 +34,8 @@ std::vector<std::string> concat(std::initializer_list<std::vector<std::string>> 
 }  // namespace
 
 TEST(Segmenter, RunsBecomeSegmentsCoveringTheWholeTime) {
-    const auto s = segment(concat({repeat("sil", 10), repeat("aa", 10), repeat("bmp", 5), repeat("sil", 10)}));
+    const auto s =
+        segment(concat({repeat("sil", 10), repeat("aa", 10), repeat("bmp", 5), repeat("sil", 10)}));
     ASSERT_EQ(s.size(), 4u);
     EXPECT_EQ(s[0].phoneme, "sil");
     EXPECT_DOUBLE_EQ(s[0].start, 0.0);
@@ -59,15 +61,16 @@ TEST(Segmenter, ConsonantsKeepTheirShorterMinimum) {
     const auto kept = segment(concat({repeat("aa", 10), repeat("bmp", 3), repeat("aa", 10)}), c);
     ASSERT_EQ(kept.size(), 3u);
     EXPECT_EQ(kept[1].phoneme, "bmp");
-    const auto vowelFlicker = segment(concat({repeat("aa", 10), repeat("ih", 4), repeat("aa", 10)}), c);
+    const auto vowelFlicker =
+        segment(concat({repeat("aa", 10), repeat("ih", 4), repeat("aa", 10)}), c);
     EXPECT_EQ(vowelFlicker.size(), 1u);
 }
 
 TEST(Segmenter, EmitsEachSegmentWithinItsReportedDelay) {
     const auto& set = PhonemeSet::common();
     dsp::Segmenter seg(set, 0.01);
-    const auto classes = concat({repeat("sil", 10), repeat("aa", 8), repeat("d", 4), repeat("ih", 9),
-                                 repeat("z", 6), repeat("sil", 20)});
+    const auto classes = concat({repeat("sil", 10), repeat("aa", 8), repeat("d", 4),
+                                 repeat("ih", 9), repeat("z", 6), repeat("sil", 20)});
     double worst = 0;
     for (std::size_t i = 0; i < classes.size(); ++i) {
         dsp::FrameLabel l;
@@ -97,19 +100,29 @@ TEST(TemplateSet, MalformedFilesNameTheField) {
         R"("analysis": {"rate": 10000, "hop": 0.01, "window": 0.025, "order": 12, "pre_emphasis": 0.97,
             "lag_window_hz": 60, "white_noise_correction": 0.0001, "bins": 4})";
     const std::string head = R"({"format": "lipsyncd-templates", "version": 1, )" + analysis;
-    EXPECT_NE(errorOf(head + R"(, "bin_weights": [1,1,1], "classes": []})").find("bin_weights has 3"),
-              std::string::npos);
-    EXPECT_NE(errorOf(head + R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "xx", "spectra": [[0,0,0,0]]}]})")
-                  .find("'xx' is not a phoneme class"),
-              std::string::npos);
-    EXPECT_NE(errorOf(head + R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "aa", "spectra": [[0,0,0]]}]})")
-                  .find("classes[0] ('aa').spectra[0] has 3 values"),
-              std::string::npos);
-    EXPECT_NE(errorOf(head + R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "aa", "spectra": "no"}]})")
-                  .find("classes[0].spectra"),
-              std::string::npos);
+    EXPECT_NE(
+        errorOf(head + R"(, "bin_weights": [1,1,1], "classes": []})").find("bin_weights has 3"),
+        std::string::npos);
+    EXPECT_NE(
+        errorOf(
+            head +
+            R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "xx", "spectra": [[0,0,0,0]]}]})")
+            .find("'xx' is not a phoneme class"),
+        std::string::npos);
+    EXPECT_NE(
+        errorOf(
+            head +
+            R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "aa", "spectra": [[0,0,0]]}]})")
+            .find("classes[0] ('aa').spectra[0] has 3 values"),
+        std::string::npos);
+    EXPECT_NE(
+        errorOf(head +
+                R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "aa", "spectra": "no"}]})")
+            .find("classes[0].spectra"),
+        std::string::npos);
     // Extra features: unknown names are refused; known ones widen every vector.
-    const std::string extra = R"({"format": "lipsyncd-templates", "version": 1, "analysis": {"rate": 10000,
+    const std::string extra =
+        R"({"format": "lipsyncd-templates", "version": 1, "analysis": {"rate": 10000,
         "hop": 0.01, "window": 0.025, "order": 12, "pre_emphasis": 0.97, "lag_window_hz": 60,
         "white_noise_correction": 0.0001, "bins": 4, "extra_features": )";
     EXPECT_NE(errorOf(extra + R"(["pitch"]}, "bin_weights": [1,1,1,1], "classes": []})")

@@ -2,12 +2,11 @@
 // helpers to write it in any format libsndfile knows.
 #pragma once
 
-#include <lipsyncd/dsp.hpp>
-#include <lipsyncd/tts.hpp>
-
 #include <sndfile.h>
 
 #include <filesystem>
+#include <lipsyncd/dsp.hpp>
+#include <lipsyncd/tts.hpp>
 #include <string>
 #include <vector>
 
@@ -37,7 +36,8 @@ inline std::vector<float> resampleOffline(const std::vector<float>& in, int from
     dsp::StreamResampler r(from, to, dsp::ResamplerQuality::High, 4096);
     std::vector<float> out;
     for (std::size_t i = 0; i < in.size(); i += 4096) {
-        const auto block = std::span<const float>(in).subspan(i, std::min<std::size_t>(4096, in.size() - i));
+        const auto block =
+            std::span<const float>(in).subspan(i, std::min<std::size_t>(4096, in.size() - i));
         const auto o = r.process(block);
         out.insert(out.end(), o.begin(), o.end());
     }
@@ -58,7 +58,9 @@ inline std::filesystem::path writeAudio(const std::string& name, const std::vect
     info.channels = static_cast<int>(gains.size());
     info.format = format;
     SNDFILE* f = sf_open(path.c_str(), SFM_WRITE, &info);
-    if (!f) throw std::runtime_error(std::string("test: cannot write ") + path.string() + ": " + sf_strerror(nullptr));
+    if (!f)
+        throw std::runtime_error(std::string("test: cannot write ") + path.string() + ": " +
+                                 sf_strerror(nullptr));
     std::vector<float> interleaved;
     for (float v : mono)
         for (float g : gains) interleaved.push_back(v * g);

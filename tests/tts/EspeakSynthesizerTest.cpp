@@ -1,10 +1,9 @@
 // espeak-ng synthesis: the audio and the phoneme events must agree, since every label in the
 // training and dev corpora comes from these events.
-#include <lipsyncd/tts.hpp>
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <lipsyncd/tts.hpp>
 
 namespace lipsyncd {
 namespace {

@@ -1,9 +1,8 @@
-#include <lipsyncd/tts.hpp>
-
 #include <espeak-ng/speak_lib.h>
 
 #include <atomic>
 #include <cstring>
+#include <lipsyncd/tts.hpp>
 
 namespace lipsyncd {
 
@@ -48,7 +47,8 @@ std::string voiceFileForLanguage(const std::string& language) {
         for (const char* p = (*voices)->languages; p && *p; p += std::strlen(p + 1) + 2) {
             const int priority = static_cast<unsigned char>(*p);
             if (language == p + 1 && priority < bestPriority && (*voices)->identifier &&
-                std::strncmp((*voices)->identifier, "mb/", 3) != 0) {  // mbrola voices need extra data
+                std::strncmp((*voices)->identifier, "mb/", 3) !=
+                    0) {  // mbrola voices need extra data
                 best = *voices;
                 bestPriority = priority;
             }
@@ -96,8 +96,8 @@ SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request)
     SynthesizedSpeech out;
     out.sampleRate = sampleRate_;
     Collector collector{&out.samples, {}};
-    const auto rc = espeak_Synth(request.text.c_str(), request.text.size() + 1, 0, POS_CHARACTER,
-                                 0, espeakCHARS_UTF8, nullptr, &collector);
+    const auto rc = espeak_Synth(request.text.c_str(), request.text.size() + 1, 0, POS_CHARACTER, 0,
+                                 espeakCHARS_UTF8, nullptr, &collector);
     if (rc != EE_OK) throw std::runtime_error("espeak-ng: synthesis failed");
     espeak_Synchronize();
 

@@ -29,7 +29,7 @@ namespace lipsyncd {
 // An error in something the user gave us (a file, an option, a request). The message reads
 // "FILE:LINE: what is wrong" (line omitted where there is none) so editors can jump to it.
 class InputError : public std::runtime_error {
-public:
+  public:
     InputError(const std::string& file, std::size_t line, const std::string& what);
     explicit InputError(const std::string& what) : std::runtime_error(what) {}
 };
@@ -51,7 +51,7 @@ struct PhonemeClass {
 };
 
 class PhonemeSet {
-public:
+  public:
     static PhonemeSet load(const std::filesystem::path& file);
     // The shipped Common Phoneme Set (config/phonemes/common.toml).
     static const PhonemeSet& common();
@@ -67,7 +67,7 @@ public:
 
     explicit PhonemeSet(std::vector<PhonemeClass> classes);  // validates; throws InputError
 
-private:
+  private:
     std::vector<PhonemeClass> classes_;
     std::unordered_map<std::string, std::size_t> index_;
     std::size_t silence_ = 0;
@@ -75,7 +75,7 @@ private:
 
 // Maps symbols of one alphabet onto class names of a PhonemeSet.
 class PhonemeMap {
-public:
+  public:
     struct Result {
         std::string phoneme;  // a class name of the set
         bool approximate;     // from the map's [nearest] table: the caller should warn
@@ -90,7 +90,7 @@ public:
     bool isIgnored(std::string_view symbol) const;
     const std::string& name() const { return name_; }
 
-private:
+  private:
     std::string normalise(std::string_view symbol) const;
     std::string name_;
     bool caseSensitive_ = true;

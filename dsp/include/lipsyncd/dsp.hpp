@@ -16,12 +16,11 @@
 // constructed, except for the segments handed out.
 #pragma once
 
-#include <lipsyncd/core.hpp>
-
 #include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <lipsyncd/core.hpp>
 #include <memory>
 #include <optional>
 #include <span>
@@ -48,7 +47,7 @@ struct DecodeOptions {
 };
 
 class AudioDecoder {
-public:
+  public:
     // Opens a file (type from its content) or, with `raw`, headerless PCM; "-" is stdin.
     static AudioDecoder open(const std::filesystem::path& file, const DecodeOptions& options = {},
                              const std::optional<RawFormat>& raw = std::nullopt);
@@ -66,7 +65,7 @@ public:
     std::int64_t nonFiniteSamples() const;
     const std::string& name() const;
 
-private:
+  private:
     struct State;
     explicit AudioDecoder(std::unique_ptr<State> state);
     std::unique_ptr<State> state_;
@@ -81,12 +80,13 @@ MonoAudio readAudioFile(const std::filesystem::path& file, const DecodeOptions& 
 // Writes 16-bit PCM WAV.
 void writeWavFile(const std::filesystem::path& file, std::span<const std::int16_t> samples,
                   int sampleRate);
-void writeWavFile(const std::filesystem::path& file, std::span<const float> samples, int sampleRate);
+void writeWavFile(const std::filesystem::path& file, std::span<const float> samples,
+                  int sampleRate);
 
 enum class ResamplerQuality { Low, Medium, High, VeryHigh };
 
 class StreamResampler {
-public:
+  public:
     StreamResampler(double inputRate, double outputRate,
                     ResamplerQuality quality = ResamplerQuality::Medium,
                     std::size_t maxBlock = 4096);
@@ -105,7 +105,7 @@ public:
     double inputRate() const { return inputRate_; }
     double outputRate() const { return outputRate_; }
 
-private:
+  private:
     struct State;
     std::unique_ptr<State> state_;
     double inputRate_, outputRate_;
@@ -144,21 +144,21 @@ struct AnalysisConfig {
 
 // Levinson–Durbin on autocorrelation r[0..order] (Makhoul 1975; Rabiner & Schafer 8.3.2).
 struct LpcResult {
-    std::array<float, kMaxOrder + 1> a{};   // A(z) = 1 + Σ a[i] z^-i, a[0] = 1
-    std::array<float, kMaxOrder> k{};       // reflection coefficients, |k| < 1
-    float predictionError = 0;              // E_p (same units as r[0])
-    float normalizedError = 1;              // E_p / r[0] in (0, 1]
-    int order = 0;                          // the order reached (less when stopped early)
-    bool stable = true;                     // false: a reflection coefficient reached |k| ≥ 1
+    std::array<float, kMaxOrder + 1> a{};  // A(z) = 1 + Σ a[i] z^-i, a[0] = 1
+    std::array<float, kMaxOrder> k{};      // reflection coefficients, |k| < 1
+    float predictionError = 0;             // E_p (same units as r[0])
+    float normalizedError = 1;             // E_p / r[0] in (0, 1]
+    int order = 0;                         // the order reached (less when stopped early)
+    bool stable = true;                    // false: a reflection coefficient reached |k| ≥ 1
 };
 LpcResult levinsonDurbin(std::span<const float> r, int order);
 
 struct FrameFeatures {
-    double time = 0;         // centre of the frame, seconds from the start of the input
-    float energyDb = -120;   // frame RMS in dBFS (before pre-emphasis)
+    double time = 0;        // centre of the frame, seconds from the start of the input
+    float energyDb = -120;  // frame RMS in dBFS (before pre-emphasis)
     float normalizedError = 1;
-    bool clipped = false;    // many samples at full scale
-    bool valid = false;      // false: silent or degenerate; spectrum is flat
+    bool clipped = false;  // many samples at full scale
+    bool valid = false;    // false: silent or degenerate; spectrum is flat
     LpcResult lpc;
     // The feature vector: log magnitude of 1/|A| in dB at spectrumBins points, then the extra
     // features the configuration asks for (featureCount() values in all).
@@ -169,7 +169,7 @@ class DirectLpcSpectrum;
 class FftLpcSpectrum;
 
 class FrameAnalyzer {
-public:
+  public:
     explicit FrameAnalyzer(const AnalysisConfig& config);
     FrameAnalyzer(FrameAnalyzer&&) noexcept;
     FrameAnalyzer& operator=(FrameAnalyzer&&) noexcept;
@@ -180,7 +180,7 @@ public:
     FrameFeatures makeFeatures() const;
     const AnalysisConfig& config() const { return config_; }
 
-private:
+  private:
     void measureLevel(std::span<const float> frame, FrameFeatures& out) const;
     void autocorrelate();
     void addExtraFeatures(FrameFeatures& out);
@@ -229,14 +229,14 @@ struct FrameLabel {
 };
 
 struct ClassifierConfig {
-    float silenceMarginDb = 12;    // a frame is silent below noise floor + margin ...
-    float absoluteSilenceDb = -55; // ... or below this level whatever the floor
-    float voicingThreshold = 0.25; // normalised prediction error below this: voiced (Lewis)
+    float silenceMarginDb = 12;           // a frame is silent below noise floor + margin ...
+    float absoluteSilenceDb = -55;        // ... or below this level whatever the floor
+    float voicingThreshold = 0.25;        // normalised prediction error below this: voiced (Lewis)
     float noiseFloorRiseDbPerSecond = 3;  // the floor follows quiet frames at once, rises slowly
 };
 
 class FrameClassifier {
-public:
+  public:
     FrameClassifier(const TemplateSet& templates, const PhonemeSet& set,
                     const ClassifierConfig& config = {});
     FrameLabel classify(const FrameFeatures& frame);
@@ -245,13 +245,13 @@ public:
     std::span<const float> distances() const { return distances_; }
     void reset();
 
-private:
+  private:
     const PhonemeSet* set_;
     ClassifierConfig config_;
     std::size_t features_ = 0, width_ = 0;  // features per frame; padded row width
-    std::vector<float> scale_;        // √ of the feature weights
-    std::vector<float> matrix_;       // every template, scaled, one padded row each
-    std::vector<int> rowClass_;       // phoneme set index of each row
+    std::vector<float> scale_;              // √ of the feature weights
+    std::vector<float> matrix_;             // every template, scaled, one padded row each
+    std::vector<int> rowClass_;             // phoneme set index of each row
     std::vector<float> scaledFrame_, rowDistances_;
     std::vector<float> distances_;
     int sil_ = 0;
@@ -267,20 +267,20 @@ struct SegmenterConfig {
     double minVowelSeconds = 0.03;
     double minConsonantSeconds = 0.02;
     double minSilenceSeconds = 0.04;
-    float switchMargin = 0.0f;          // extra confidence a new class needs (hysteresis)
+    float switchMargin = 0.0f;  // extra confidence a new class needs (hysteresis)
 };
 
 // Turns frame labels into segments. Streaming: push() frames as they come; closed segments
 // come out once no later frame can change them. The delay is bounded (delaySeconds()).
 class Segmenter {
-public:
+  public:
     Segmenter(const PhonemeSet& set, double hopSeconds, const SegmenterConfig& config = {});
     // Returns the segments closed by this frame (usually none; at most a few).
     std::span<const PhonemeSegment> push(const FrameLabel& label);
     std::span<const PhonemeSegment> finish(double endTime);
     double delaySeconds() const;
 
-private:
+  private:
     struct Run {
         int phoneme;
         double start, end;
@@ -313,7 +313,7 @@ struct FrontEndConfig {
 
 // Resampling and framing: samples at any rate in, analysed frames (features) out, every hop.
 class FrameStream {
-public:
+  public:
     using Sink = std::function<void(const FrameFeatures&)>;
     FrameStream(const AnalysisConfig& config, double inputRate,
                 ResamplerQuality quality = ResamplerQuality::Medium);
@@ -325,7 +325,7 @@ public:
     double resamplerDelaySeconds() const { return resampler_.delaySeconds(); }
     const AnalysisConfig& config() const { return analyzer_.config(); }
 
-private:
+  private:
     void append(std::span<const float> resampled, const Sink& sink);
     void analyzeReadyFrames(const Sink& sink);
 
@@ -346,7 +346,7 @@ std::vector<FrameFeatures> analyzeFrames(const std::filesystem::path& file,
                                          const DecodeOptions& decode = {});
 
 class StreamingAnalyzer {
-public:
+  public:
     struct Frame {
         FrameFeatures features;
         FrameLabel label;
@@ -367,7 +367,7 @@ public:
     double latencySeconds() const;
     double resamplerDelaySeconds() const { return frames_.resamplerDelaySeconds(); }
 
-private:
+  private:
     void onFeatures(const FrameFeatures& features);
 
     TemplateSet templates_;
@@ -408,15 +408,15 @@ struct TrainingOptions {
     int clustersPerClass = 16;
     std::size_t minFramesPerCluster = 40;
     double boundaryMarginSeconds = 0.02;  // frames this near a label boundary are transitions
-    float maxBelowPeakDb = 35;       // frames this far below the utterance's peak are not speech
-    std::uint32_t seed = 1;          // k-means++ seeding: fixed, so training is reproducible
+    float maxBelowPeakDb = 35;  // frames this far below the utterance's peak are not speech
+    std::uint32_t seed = 1;     // k-means++ seeding: fixed, so training is reproducible
 };
 
 // Builds templates as cluster means of labelled frames (k-means per class on LPC spectra, the
 // viseme clusters of paper 001 section 4 applied to spectra) and per-bin distance weights from
 // the pooled within-class variance.
 class TemplateTrainer {
-public:
+  public:
     TemplateTrainer(const TrainingOptions& options, const PhonemeSet& set);
     // Frames of one utterance with its reference labels (common-set names).
     void addUtterance(std::span<const FrameFeatures> frames, const PhonemeSchedule& labels);
@@ -426,7 +426,7 @@ public:
     // Throws InputError when no class has enough frames.
     TemplateSet build(const std::string& description) const;
 
-private:
+  private:
     void addFrame(const FrameFeatures& frame, std::size_t phoneme);
     TrainingOptions options_;
     const PhonemeSet* set_;
@@ -439,7 +439,9 @@ struct ScheduleScore {
     std::vector<std::vector<std::size_t>> confusion;  // [reference][hypothesis], set indices
 
     double accuracy() const { return frames ? static_cast<double>(correct) / frames : 0.0; }
-    double groupAccuracy() const { return frames ? static_cast<double>(groupCorrect) / frames : 0.0; }
+    double groupAccuracy() const {
+        return frames ? static_cast<double>(groupCorrect) / frames : 0.0;
+    }
     void add(const ScheduleScore& other);
 };
 ScheduleScore scoreSchedule(const PhonemeSchedule& hypothesis, const PhonemeSchedule& reference,
