@@ -7,6 +7,7 @@
 #include "Commands.hpp"
 #include "FrontEndOptions.hpp"
 #include "Output.hpp"
+#include "RuntimeOptions.hpp"
 
 namespace lipsyncd::cli {
 
@@ -17,6 +18,7 @@ struct AnalyzeOptions {
     std::string format = "tsv";
     std::string frames;
     FrontEndOptions frontEnd;
+    RuntimeOptions runtime;
     bool quiet = false;
 };
 
@@ -47,14 +49,16 @@ void runAnalyze(const AnalyzeOptions& o) {
                   << result.durationSeconds << " s at " << result.inputRate << " Hz, "
                   << result.schedule.size() << " segments (resampler delay " << std::setprecision(1)
                   << result.resamplerDelaySeconds * 1000 << " ms)\n";
-    withOutputStream(o.schedule, [&](std::ostream& out) {
-        if (o.format == "json")
-            writeScheduleJson(out, result.schedule);
-        else
-            writeSchedule(out, result.schedule);
-    });
+    if (!o.schedule.empty())
+        withOutputStream(o.schedule, [&](std::ostream& out) {
+            if (o.format == "json")
+                writeScheduleJson(out, result.schedule);
+            else
+                writeSchedule(out, result.schedule);
+        });
     if (!o.frames.empty())
         withOutputStream(o.frames, [&](std::ostream& out) { writeFrames(out, result, set); });
+    if (!o.runtime.weights.empty()) o.runtime.writeWeights(o.runtime.animate(result.schedule));
 }
 }  // namespace
 
@@ -63,8 +67,7 @@ void addAnalyzeCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "analyze", "Analyse speech audio into a timed phoneme schedule (linear prediction)");
     cmd->add_option("input", o->input, "Audio file (WAV, FLAC, OGG; '-' for stdin)")->required();
-    cmd->add_option("--schedule,-s", o->schedule, "Write the schedule here ('-' for stdout)")
-        ->required();
+    auto* schedule = cmd->add_option("--schedule,-s", o->schedule, "Write the schedule here ('-' for stdout)");
     cmd->add_option("--format", o->format, "Schedule format")
         ->check(CLI::IsMember({"tsv", "json"}))
         ->capture_default_str();
@@ -72,7 +75,12 @@ void addAnalyzeCommand(CLI::App& app) {
                     "Also write per-frame energy, voicing, class, runner-up and distances (CSV)");
     cmd->add_flag("--quiet,-q", o->quiet, "No summary on stderr");
     o->frontEnd.addTo(*cmd);
-    cmd->callback([o] { runAnalyze(*o); });
+    o->runtime.addTo(*cmd, true);
+    cmd->callback([o, schedule] {
+        if (o->schedule.empty() && o->runtime.weights.empty())
+            throw CLI::ValidationError(schedule->get_name(), "nothing to write: give --schedule and/or --weights");
+        runAnalyze(*o);
+    });
 }
 
 }  // namespace lipsyncd::cli

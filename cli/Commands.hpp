@@ -11,5 +11,7 @@ void addAnalyzeCommand(CLI::App& app);
 void addEvalCommand(CLI::App& app);
 void addTrainCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);
+void addAnimateCommand(CLI::App& app);
+void addCurvesCommand(CLI::App& app);
 
 }  // namespace lipsyncd::cli

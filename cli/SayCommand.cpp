@@ -1,6 +1,7 @@
 // lipsync say: espeak-ng speaks a line; its own phoneme events give the exact schedule.
 #include "Commands.hpp"
 #include "Output.hpp"
+#include "RuntimeOptions.hpp"
 
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/dsp.hpp>
@@ -19,20 +20,25 @@ struct SayOptions {
     std::string wav;
     std::string schedule;
     bool raw = false;
+    RuntimeOptions runtime;
 };
 
 void runSay(const SayOptions& o) {
     EspeakSynthesizer synth;
     const auto speech = synth.synthesize({o.text, o.voice, o.rate, o.pitch});
     if (!o.wav.empty()) dsp::writeWavFile(o.wav, speech.samples, speech.sampleRate);
-    if (!o.schedule.empty()) {
-        PhonemeSchedule schedule = speech.phonemes;
-        if (!o.raw) {
-            std::vector<std::string> warnings;
-            schedule = mapSchedule(speech.phonemes, espeakMapForVoice(o.voice), &warnings);
-            for (const auto& w : warnings) std::cerr << "lipsync say: warning: " << w << '\n';
-        }
+    if (o.schedule.empty() && o.runtime.weights.empty()) return;
+    PhonemeSchedule schedule = speech.phonemes;
+    if (!o.raw) {
+        std::vector<std::string> warnings;
+        schedule = mapSchedule(speech.phonemes, espeakMapForVoice(o.voice), &warnings);
+        for (const auto& w : warnings) std::cerr << "lipsync say: warning: " << w << '\n';
+    }
+    if (!o.schedule.empty())
         withOutputStream(o.schedule, [&](std::ostream& out) { writeSchedule(out, schedule, false); });
+    if (!o.runtime.weights.empty()) {
+        if (o.raw) throw CLI::ValidationError("--weights", "needs the common set: drop --raw-phonemes");
+        o.runtime.writeWeights(o.runtime.animate(schedule));
     }
 }
 }  // namespace
@@ -52,9 +58,10 @@ void addSayCommand(CLI::App& app) {
     cmd->add_option("--schedule", o->schedule, "Write the phoneme schedule (TSV, '-' for stdout)");
     cmd->add_flag("--raw-phonemes", o->raw,
                   "Schedule in espeak-ng's own mnemonics instead of the common set");
+    o->runtime.addTo(*cmd, true);
     cmd->callback([o] {
-        if (o->wav.empty() && o->schedule.empty())
-            throw CLI::ValidationError("say", "nothing to write: give --wav and/or --schedule");
+        if (o->wav.empty() && o->schedule.empty() && o->runtime.weights.empty())
+            throw CLI::ValidationError("say", "nothing to write: give --wav, --schedule and/or --weights");
         runSay(*o);
     });
 }

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
     addTrainCommand(app);
     addCalibrateCommand(app);
     addSayCommand(app);
+    addAnimateCommand(app);
+    addCurvesCommand(app);
 
     try {
         app.parse(argc, argv);

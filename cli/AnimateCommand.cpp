@@ -1,0 +1,73 @@
+// lipsync animate: a phoneme schedule to mouth-pose weights (the phone-bigram runtime), and
+// lipsync curves generate: the curve set from its rules.
+#include "Commands.hpp"
+#include "Corpus.hpp"
+#include "RuntimeOptions.hpp"
+
+#include <iostream>
+
+namespace lipsyncd::cli {
+
+namespace {
+struct AnimateOptions {
+    std::string schedule;
+    std::string labels = "auto";
+    double delay = -1;  // < 0: offline
+    RuntimeOptions runtime;
+};
+
+void runAnimate(const AnimateOptions& o) {
+    const auto schedule = readLabels(o.schedule, o.labels);
+    if (o.delay < 0) {
+        o.runtime.writeWeights(o.runtime.animate(schedule));
+        return;
+    }
+    // Streaming, as the daemon runs it: segment by segment, with the given delay.
+    const auto loaded = o.runtime.load();
+    lipsync::StreamingRuntime stream(loaded.curves, loaded.poses, o.delay, o.runtime.config);
+    PoseTrack track;
+    for (const auto& s : schedule) stream.push(s, track);
+    stream.finish(track);
+    o.runtime.writeWeights(track);
+}
+
+struct GenerateOptions {
+    std::string rules = "curves/english-rules.toml";
+    std::string output;
+    std::string poses = "facefx";
+};
+}  // namespace
+
+void addAnimateCommand(CLI::App& app) {
+    auto o = std::make_shared<AnimateOptions>();
+    auto* cmd = app.add_subcommand(
+        "animate", "Turn a phoneme schedule into mouth-pose weights (phone-bigram runtime)");
+    cmd->add_option("--schedule", o->schedule, "Schedule or labels (TSV/.lab; '-' for stdin)")->required();
+    cmd->add_option("--weights", o->runtime.weights, "Pose weights to write (CSV; '-' for stdout)")->required();
+    cmd->add_option("--labels", o->labels,
+                    "Schedule alphabet: auto, common, arpabet, ipa, espeak-en, or a map file")
+        ->capture_default_str();
+    cmd->add_option("--delay", o->delay,
+                    "Run streaming with this delay in seconds (0: causal), as the daemon does");
+    o->runtime.addTo(*cmd, false);
+    cmd->callback([o] { runAnimate(*o); });
+}
+
+void addCurvesCommand(CLI::App& app) {
+    auto* curves = app.add_subcommand("curves", "Bigram curve sets: generate one from its rules");
+    curves->require_subcommand(1);
+    auto o = std::make_shared<GenerateOptions>();
+    auto* gen = curves->add_subcommand(
+        "generate", "Build a curve set from per-class targets and coarticulation rules");
+    gen->add_option("--rules", o->rules, "Rules file (TOML)")->capture_default_str();
+    gen->add_option("-o,--output", o->output, "Curve set to write (JSON)")->required();
+    gen->add_option("--poses", o->poses, "Pose set")->capture_default_str();
+    gen->callback([o] {
+        const auto poses = lipsync::PoseSet::named(o->poses);
+        const auto set = lipsync::generateCurveSet(findDataFile(o->rules), poses);
+        set.save(o->output, poses, PhonemeSet::common());
+        std::cerr << "lipsync curves: wrote " << o->output << '\n';
+    });
+}
+
+}  // namespace lipsyncd::cli

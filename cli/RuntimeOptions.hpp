@@ -1,0 +1,60 @@
+// Options every command that runs the phone-bigram runtime shares: pose set, curve set,
+// character, output rate, the steps to run, and the weights file to write.
+#pragma once
+
+#include "Output.hpp"
+
+#include <lipsyncd/lipsync.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <memory>
+#include <string>
+
+namespace lipsyncd::cli {
+
+struct RuntimeOptions {
+    std::string weights;  // where to write pose weights (CSV); empty: not asked for
+    std::string poses = "facefx";
+    std::string curves = "english";
+    std::string character;
+    lipsync::RuntimeConfig config;
+
+    // `withWeights`: add --weights (commands whose main output is something else).
+    void addTo(CLI::App& cmd, bool withWeights) {
+        if (withWeights)
+            cmd.add_option("--weights", weights, "Write mouth-pose weights here (CSV, '-' for stdout)");
+        cmd.add_option("--poses", poses, "Pose set (config/poses/NAME.toml, or a file)")->capture_default_str();
+        cmd.add_option("--curves", curves, "Bigram curve set (config/curves/NAME.json, or a file)")
+            ->capture_default_str();
+        cmd.add_option("--character", character,
+                       "Character file: a base curve set with some bigrams replaced");
+        cmd.add_option("--weights-rate", config.outputRate, "Pose-weight frames per second")
+            ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
+        cmd.add_flag("!--no-smoothing", config.smoothing, "Skip valley smoothing (for comparison)");
+        cmd.add_flag("!--no-constraints", config.constraints, "Skip pose-pair constraints");
+        cmd.add_flag("!--no-speed-limits", config.speedLimits, "Skip speed limits");
+    }
+
+    struct Loaded {
+        lipsync::PoseSet poses;
+        lipsync::BigramCurveSet curves;
+    };
+    Loaded load() const {
+        auto poseSet = lipsync::PoseSet::named(poses);
+        auto set = character.empty() ? lipsync::BigramCurveSet::named(curves, poseSet)
+                                     : lipsync::BigramCurveSet::load(findDataFile(character), poseSet);
+        return {std::move(poseSet), std::move(set)};
+    }
+
+    PoseTrack animate(const PhonemeSchedule& schedule) const {
+        const auto loaded = load();
+        return lipsync::animate(schedule, loaded.curves, loaded.poses, config);
+    }
+
+    void writeWeights(const PoseTrack& track) const {
+        withOutputStream(weights, [&](std::ostream& out) { writePoseTrackCsv(out, track); });
+    }
+};
+
+}  // namespace lipsyncd::cli

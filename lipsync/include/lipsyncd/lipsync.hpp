@@ -1,0 +1,212 @@
+// lipsync: phoneme schedule in, mouth-pose weights out, by the phone-bigram method
+// (shared/seeds/000, section 2.2).
+//
+//   PoseSet          the canonical mouth poses (config/poses/*.toml): per pose a priority, a
+//                    speed limit and a smoothing window; per pose pair a constraint threshold.
+//   ControlCurve     a piecewise-linear control polygon over normalised time [0, 1] and the
+//                    smooth uniform cubic B-spline it controls (what the runtime evaluates).
+//   BigramCurveSet   per phone bigram and pose, a ControlCurve (config/curves/*.json); a
+//                    character file overrides single bigrams of a base set.
+//   generateCurveSet the shipped English set from per-class targets and coarticulation rules.
+//   animate()        the runtime, offline: pairs → time-warp → stitch with max → valley
+//                    smoothing → constraints → speed limits, each step switchable.
+//   StreamingRuntime the same, fed segment by segment, with a fixed delay (or causal).
+#pragma once
+
+#include <lipsyncd/core.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace lipsyncd::lipsync {
+
+// ---------------------------------------------------------------------------------------------
+// Poses.
+
+struct Pose {
+    std::string name;
+    int priority = 0;               // on a constraint, the lower-priority pose gives way
+    double speedLimit = 6.0;        // weight units per second (section 2.2.3)
+    double smoothingWindow = 0.18;  // 2·t_w, seconds (section 2.2.1)
+};
+
+// C(a, b): when c_a + c_b > threshold, the lower-priority of the two is reduced (2.2.2).
+struct PoseConstraint {
+    std::size_t high = 0, low = 0;  // pose indices, priority(high) > priority(low)
+    double threshold = 2.0;
+};
+
+class PoseSet {
+public:
+    static PoseSet load(const std::filesystem::path& file);  // validates; InputError
+    static PoseSet named(const std::string& nameOrPath);     // "facefx" → config/poses/facefx.toml
+
+    const std::string& name() const { return name_; }
+    std::size_t size() const { return poses_.size(); }
+    const Pose& operator[](std::size_t i) const { return poses_[i]; }
+    std::span<const Pose> poses() const { return poses_; }
+    std::vector<std::string> names() const;
+    std::optional<std::size_t> find(const std::string& name) const;
+    // In the order they are applied: by the higher pose's priority, highest first.
+    std::span<const PoseConstraint> constraints() const { return constraints_; }
+
+    PoseSet(std::string name, std::vector<Pose> poses, std::vector<PoseConstraint> constraints);
+
+private:
+    std::string name_;
+    std::vector<Pose> poses_;
+    std::vector<PoseConstraint> constraints_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Curves.
+
+struct ControlPoint {
+    float time = 0;   // normalised, in [0, 1]
+    float value = 0;  // pose weight, in [0, 1]
+    bool operator==(const ControlPoint&) const = default;
+};
+
+// The paper's curve l(t) is the control polygon of a smooth B-spline c(t). The polygon's
+// vertices are the control points of a clamped uniform cubic B-spline in the (time, value)
+// plane; it starts and ends on the polygon's end points and stays inside its convex hull, so
+// values stay in [0, 1]. It is sampled densely once, at load time.
+class ControlCurve {
+public:
+    explicit ControlCurve(std::vector<ControlPoint> polygon);  // validated by the caller
+    float at(double u) const;                                   // u in [0, 1], clamped
+    std::span<const ControlPoint> polygon() const { return polygon_; }
+
+private:
+    std::vector<ControlPoint> polygon_;
+    std::vector<float> samples_;  // c(u) at u = i / (samples_.size() - 1)
+};
+
+class BigramCurveSet {
+public:
+    // A curve set (format "lipsyncd-curves") or a character file ("lipsyncd-character": a base
+    // set plus overridden bigrams). Validates everything; errors name the bigram and pose.
+    static BigramCurveSet load(const std::filesystem::path& file, const PoseSet& poses,
+                               const PhonemeSet& phonemes = PhonemeSet::common());
+    static BigramCurveSet named(const std::string& nameOrPath, const PoseSet& poses,
+                                const PhonemeSet& phonemes = PhonemeSet::common());
+    // An empty set (every curve zero) over these classes and poses: the generator fills it.
+    BigramCurveSet(std::string name, const PoseSet& poses, const PhonemeSet& phonemes);
+
+    // The curve of `pose` for the bigram (first, second), or nullptr when the pose stays at 0.
+    const ControlCurve* curve(std::size_t first, std::size_t second, std::size_t pose) const;
+    void setCurve(std::size_t first, std::size_t second, std::size_t pose, ControlCurve curve);
+    // Applies a character file's bigrams on top of this set.
+    void applyOverrides(const std::filesystem::path& characterFile, const PoseSet& poses,
+                        const PhonemeSet& phonemes = PhonemeSet::common());
+
+    const std::string& name() const { return name_; }
+    std::string& description() { return description_; }
+    std::size_t classes() const { return classes_; }
+    std::size_t poses() const { return poses_; }
+    // Writes the set (format "lipsyncd-curves", version 1), deterministically.
+    void save(const std::filesystem::path& file, const PoseSet& poseSet, const PhonemeSet& set) const;
+
+private:
+    std::size_t slot(std::size_t first, std::size_t second, std::size_t pose) const {
+        return (first * classes_ + second) * poses_ + pose;
+    }
+    std::string name_, description_;
+    std::size_t classes_ = 0, poses_ = 0;
+    std::vector<std::optional<ControlCurve>> curves_;
+};
+
+// The shipped English set: per-class target poses and coarticulation rules, from a rules file
+// (config/curves/english-rules.toml; format documented in config/curves/README.md).
+BigramCurveSet generateCurveSet(const std::filesystem::path& rulesFile, const PoseSet& poses,
+                                const PhonemeSet& phonemes = PhonemeSet::common());
+
+// ---------------------------------------------------------------------------------------------
+// The runtime.
+
+struct RuntimeConfig {
+    double outputRate = 100;  // weight frames per second
+    // Each step of section 2.2 after the stitch can be switched off, for comparison.
+    bool smoothing = true;
+    bool constraints = true;
+    bool speedLimits = true;
+};
+
+// Pose weights over time, one row of `poses` values per output frame: the runtime's working
+// form (pose-major, so each step runs down one curve at a time).
+struct PoseCurves {
+    double startTime = 0;        // time of global frame 0
+    std::size_t firstFrame = 0;  // global index of values[p][0] (streaming works on a window)
+    double rate = 100;
+    std::size_t frames = 0;
+    std::vector<std::vector<float>> values;  // [pose][frame]
+
+    PoseCurves(std::size_t poses, double rate, double startTime, std::size_t firstFrame, std::size_t frames);
+    double timeOf(std::size_t frame) const {
+        return startTime + static_cast<double>(firstFrame + frame) / rate;
+    }
+};
+
+// The steps, in the paper's order (each in its own file, each with its own tests).
+// Pairs (p_i, p_i+1) over (t_i, t_i+2), curves warped onto that span, overlaps stitched with
+// max (2.2.1). The schedule is bracketed by zero-length silence (where it starts and ends,
+// unless told it continues), so the first and last phonemes are covered by a pair too.
+struct Bracket {
+    bool start = true, end = true;
+};
+void stitchBigrams(std::span<const PhonemeSegment> schedule, const BigramCurveSet& set,
+                   const PhonemeSet& phonemes, PoseCurves& curves, Bracket bracket = {});
+// Valleys between two local maxima less than the pose's window apart are filled by the line
+// between the maxima (2.2.1).
+void smoothValleys(std::span<float> curve, double rate, double window);
+// c_a + c_b ≤ C(a, b): the lower-priority pose gives way (2.2.2).
+void applyConstraints(const PoseSet& poses, PoseCurves& curves, std::size_t fromFrame = 0);
+// |dc/dt| ≤ the pose's limit, frame by frame from `previous` (the last frame already out);
+// never re-breaks a constraint (2.2.3).
+void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const float> previous,
+                PoseCurves& curves, std::size_t fromFrame = 0);
+
+// The whole runtime over a schedule (contiguous, common-set names).
+PoseTrack animate(std::span<const PhonemeSegment> schedule, const BigramCurveSet& set,
+                  const PoseSet& poses, const RuntimeConfig& config = {},
+                  const PhonemeSet& phonemes = PhonemeSet::common());
+
+// Streaming: segments arrive as the front end closes them; weights leave with a fixed delay.
+// A frame at time t goes out once segments are closed up to t + delay. With a delay longer
+// than two segments plus the smoothing window, the output equals animate()'s exactly.
+// delay = 0 is the causal mode: the next phoneme is unknown, so frames up to the last closed
+// boundary are computed against an estimate (the current phoneme continued, for its mean
+// duration so far) and go out at once.
+class StreamingRuntime {
+public:
+    StreamingRuntime(const BigramCurveSet& set, const PoseSet& poses, double delaySeconds,
+                     const RuntimeConfig& config = {},
+                     const PhonemeSet& phonemes = PhonemeSet::common());
+    // Appends the frames that became final to `out` (out.poses must be the pose names).
+    void push(const PhonemeSegment& segment, PoseTrack& out);
+    void finish(PoseTrack& out);
+    double delaySeconds() const { return delay_; }
+
+private:
+    void emitUntil(double until, bool final, PoseTrack& out);
+    void dropOldSegments();
+
+    const BigramCurveSet* set_;
+    const PoseSet* poses_;
+    const PhonemeSet* phonemes_;
+    RuntimeConfig config_;
+    double delay_;
+    std::vector<PhonemeSegment> window_;  // recent segments (older ones are dropped)
+    bool started_ = false;
+    bool atStart_ = true;                 // window_ still holds the first segment
+    double origin_ = 0;                   // time of frame 0: the first segment's start
+    std::size_t emitted_ = 0;             // frames already out
+    std::vector<float> last_;             // the last frame out
+};
+
+}  // namespace lipsyncd::lipsync

@@ -1,0 +1,95 @@
+// Pose sets as data (config/poses/*.toml), read strictly: unknown keys, unknown poses, repeated
+// names and out-of-range numbers stop loading with the file and line.
+#include <lipsyncd/lipsync.hpp>
+#include <lipsyncd/toml_table.hpp>
+
+#include <algorithm>
+
+namespace lipsyncd::lipsync {
+
+PoseSet::PoseSet(std::string name, std::vector<Pose> poses, std::vector<PoseConstraint> constraints)
+    : name_(std::move(name)), poses_(std::move(poses)), constraints_(std::move(constraints)) {
+    // Section 2.2.2 resolves each constraint by priority; applying the ones whose winning pose
+    // ranks highest first means a pose is final before it limits anything lower.
+    std::stable_sort(constraints_.begin(), constraints_.end(), [&](const auto& a, const auto& b) {
+        return poses_[a.high].priority > poses_[b.high].priority;
+    });
+}
+
+std::vector<std::string> PoseSet::names() const {
+    std::vector<std::string> out;
+    for (const auto& p : poses_) out.push_back(p.name);
+    return out;
+}
+
+std::optional<std::size_t> PoseSet::find(const std::string& name) const {
+    for (std::size_t i = 0; i < poses_.size(); ++i)
+        if (poses_[i].name == name) return i;
+    return std::nullopt;
+}
+
+namespace {
+double positive(const TomlTable& t, const std::string& key, double fallback) {
+    const double v = t.optNumber(key).value_or(fallback);
+    if (!(v > 0)) t.fail(key, "must be greater than 0");
+    return v;
+}
+
+std::vector<PoseConstraint> readConstraints(const TomlTable& root, const std::vector<Pose>& poses) {
+    std::vector<PoseConstraint> out;
+    for (const auto& c : root.tableArray("constraint")) {
+        const auto names = c.optStringArray("poses");
+        if (!names || names->size() != 2) c.fail("poses", "must name exactly two poses");
+        std::size_t idx[2];
+        for (int i = 0; i < 2; ++i) {
+            auto it = std::find_if(poses.begin(), poses.end(), [&](const Pose& p) { return p.name == (*names)[i]; });
+            if (it == poses.end()) c.fail("poses", "unknown pose '" + (*names)[i] + "'");
+            idx[i] = static_cast<std::size_t>(it - poses.begin());
+        }
+        if (idx[0] == idx[1]) c.fail("poses", "a pose cannot constrain itself");
+        if (poses[idx[0]].priority == poses[idx[1]].priority)
+            c.fail("poses", "'" + poses[idx[0]].name + "' and '" + poses[idx[1]].name +
+                                "' have the same priority: which one gives way?");
+        PoseConstraint pc;
+        pc.high = poses[idx[0]].priority > poses[idx[1]].priority ? idx[0] : idx[1];
+        pc.low = pc.high == idx[0] ? idx[1] : idx[0];
+        pc.threshold = c.getNumber("threshold");
+        if (!(pc.threshold >= 0 && pc.threshold <= 2)) c.fail("threshold", "must be in [0, 2]");
+        c.finish();
+        out.push_back(pc);
+    }
+    return out;
+}
+}  // namespace
+
+PoseSet PoseSet::load(const std::filesystem::path& file) {
+    const auto root = TomlTable::parseFile(file);
+    const auto name = root.getString("name");
+    root.optString("description");
+    const double speed = positive(root, "speed_limit", 6.0);
+    const double window = positive(root, "smoothing_window", 0.18);
+    std::vector<Pose> poses;
+    for (const auto& t : root.tableArray("pose")) {
+        Pose p;
+        p.name = t.getString("name");
+        if (std::any_of(poses.begin(), poses.end(), [&](const Pose& q) { return q.name == p.name; }))
+            t.fail("name", "pose '" + p.name + "' is defined twice");
+        p.priority = static_cast<int>(t.optInteger("priority").value_or(0));
+        p.speedLimit = positive(t, "speed_limit", speed);
+        p.smoothingWindow = positive(t, "smoothing_window", window);
+        t.finish();
+        poses.push_back(std::move(p));
+    }
+    if (poses.empty()) throw InputError(file.string(), 0, "no [[pose]] defined");
+    auto constraints = readConstraints(root, poses);
+    root.finish();
+    return PoseSet(name, std::move(poses), std::move(constraints));
+}
+
+PoseSet PoseSet::named(const std::string& nameOrPath) {
+    const std::filesystem::path p(nameOrPath);
+    if (p.has_extension() || p.has_parent_path()) return load(findDataFile(p));
+    return load(findDataFile(std::filesystem::path("poses") / (nameOrPath + ".toml")));
+}
+
+}  // namespace lipsyncd::lipsync
