@@ -23,9 +23,18 @@ std::size_t classOf(const PhonemeSegment& s, const PhonemeSet& phonemes) {
     return *idx;
 }
 
+// The time-warp: normalised time 0..½ runs over the first phoneme and ½..1 over the second, so
+// a curve authored for phonemes of equal length keeps its timing relative to each phoneme when
+// their lengths differ (a long vowel after a short consonant holds its pose through its own
+// middle instead of sagging where a uniform stretch would put the boundary).
+double warp(double t, double t0, double boundary, double t1) {
+    if (t < boundary) return boundary > t0 ? 0.5 * (t - t0) / (boundary - t0) : 0.5;
+    return t1 > boundary ? 0.5 + 0.5 * (t - boundary) / (t1 - boundary) : 0.5;
+}
+
 // Warps one bigram's curves onto [t0, t1] and keeps the larger value per frame.
-void stitchPair(const BigramCurveSet& set, std::size_t a, std::size_t b, double t0, double t1,
-                PoseCurves& curves) {
+void stitchPair(const BigramCurveSet& set, std::size_t a, std::size_t b, double t0, double boundary,
+                double t1, PoseCurves& curves) {
     if (!(t1 > t0) || curves.frames == 0) return;
     const double origin = curves.startTime + static_cast<double>(curves.firstFrame) / curves.rate;
     const double first = std::ceil((t0 - origin) * curves.rate - 1e-9);
@@ -38,7 +47,7 @@ void stitchPair(const BigramCurveSet& set, std::size_t a, std::size_t b, double 
         if (!c) continue;
         auto& v = curves.values[p];
         for (std::size_t f = from; f <= to; ++f)
-            v[f] = std::max(v[f], c->at((curves.timeOf(f) - t0) / (t1 - t0)));
+            v[f] = std::max(v[f], c->at(warp(curves.timeOf(f), t0, boundary, t1)));
     }
 }
 }  // namespace
@@ -50,13 +59,13 @@ void stitchBigrams(std::span<const PhonemeSegment> schedule, const BigramCurveSe
     // Bracketing silence of zero length: the pair (sil, p_0) spans p_0 alone, (p_n, sil) p_n.
     if (bracket.start)
         stitchPair(set, sil, classOf(schedule.front(), phonemes), schedule.front().start,
-                   schedule.front().end, curves);
+                   schedule.front().start, schedule.front().end, curves);
     for (std::size_t i = 0; i + 1 < schedule.size(); ++i)
         stitchPair(set, classOf(schedule[i], phonemes), classOf(schedule[i + 1], phonemes),
-                   schedule[i].start, schedule[i + 1].end, curves);
+                   schedule[i].start, schedule[i].end, schedule[i + 1].end, curves);
     if (bracket.end)
         stitchPair(set, classOf(schedule.back(), phonemes), sil, schedule.back().start,
-                   schedule.back().end, curves);
+                   schedule.back().end, schedule.back().end, curves);
 }
 
 }  // namespace lipsyncd::lipsync

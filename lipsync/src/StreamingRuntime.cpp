@@ -40,7 +40,12 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out) {
     if (lastFrame < static_cast<long long>(emitted_)) return;
     const auto firstFrame = static_cast<std::size_t>(
         std::max(0.0, std::ceil((window_.front().start - origin_) * rate - 1e-9)));
-    const std::size_t frames = static_cast<std::size_t>(lastFrame) + 1 - firstFrame;
+    // Work past the last frame to let out by a smoothing window, so that a curve cut short
+    // there does not look like a peak to the valley smoothing.
+    const auto known = static_cast<long long>(std::floor((window_.back().end - origin_) * rate + 1e-9));
+    const auto margin = static_cast<long long>(std::ceil(longestWindow() * rate)) + 2;
+    const auto workTo = final ? lastFrame : std::min(known, lastFrame + margin);
+    const std::size_t frames = static_cast<std::size_t>(workTo) + 1 - firstFrame;
     PoseCurves curves(poses_->size(), rate, origin_, firstFrame, frames);
 
     std::vector<PhonemeSegment> schedule(window_.begin(), window_.end());
@@ -59,7 +64,8 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out) {
     if (config_.constraints) applyConstraints(*poses_, curves, from);
     if (config_.speedLimits) limitSpeed(*poses_, config_.constraints, last_, curves, from);
 
-    for (std::size_t f = from; f < frames; ++f) {
+    const std::size_t end = static_cast<std::size_t>(lastFrame) + 1 - firstFrame;
+    for (std::size_t f = from; f < end; ++f) {
         for (std::size_t p = 0; p < poses_->size(); ++p) last_[p] = curves.values[p][f];
         out.append(curves.timeOf(f), last_);
     }
@@ -68,10 +74,14 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out) {
 }
 
 // Keeps two segments before the margin: frames inside window_[1] see both bigrams covering them.
+double StreamingRuntime::longestWindow() const {
+    double longest = 0;
+    for (const auto& p : poses_->poses()) longest = std::max(longest, p.smoothingWindow);
+    return longest;
+}
+
 void StreamingRuntime::dropOldSegments() {
-    double longestWindow = 0;
-    for (const auto& p : poses_->poses()) longestWindow = std::max(longestWindow, p.smoothingWindow);
-    const double keepFrom = origin_ + static_cast<double>(emitted_) / config_.outputRate - longestWindow - 0.05;
+    const double keepFrom = origin_ + static_cast<double>(emitted_) / config_.outputRate - longestWindow() - 0.05;
     while (window_.size() > 3 && window_[2].start <= keepFrom) {
         window_.erase(window_.begin());
         atStart_ = false;

@@ -153,8 +153,8 @@ struct PoseCurves {
 };
 
 // The steps, in the paper's order (each in its own file, each with its own tests).
-// Pairs (p_i, p_i+1) over (t_i, t_i+2), curves warped onto that span, overlaps stitched with
-// max (2.2.1). The schedule is bracketed by zero-length silence (where it starts and ends,
+// Pairs (p_i, p_i+1) over (t_i, t_i+2), curves warped onto that span (each phoneme's half of
+// normalised time onto that phoneme), overlaps stitched with max (2.2.1). The schedule is bracketed by zero-length silence (where it starts and ends,
 // unless told it continues), so the first and last phonemes are covered by a pair too.
 struct Bracket {
     bool start = true, end = true;
@@ -195,6 +195,7 @@ public:
 private:
     void emitUntil(double until, bool final, PoseTrack& out);
     void dropOldSegments();
+    double longestWindow() const;
 
     const BigramCurveSet* set_;
     const PoseSet* poses_;
