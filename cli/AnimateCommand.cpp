@@ -18,6 +18,8 @@ struct AnimateOptions {
 
 void runAnimate(const AnimateOptions& o) {
     const auto schedule = readLabels(o.schedule, o.labels);
+    if (o.delay >= 0 && o.runtime.runtime != "bigram")
+        throw CLI::ValidationError("--delay", "streaming is for --runtime bigram");
     if (o.delay < 0) {
         o.runtime.writeWeights(o.runtime.animate(schedule));
         return;

@@ -18,6 +18,7 @@ struct RuntimeOptions {
     std::string poses = "facefx";
     std::string curves = "english";
     std::string character;
+    std::string runtime = "bigram";
     lipsync::RuntimeConfig config;
 
     // `withWeights`: add --weights (commands whose main output is something else).
@@ -26,6 +27,11 @@ struct RuntimeOptions {
             cmd.add_option("--weights", weights, "Write mouth-pose weights here (CSV, '-' for stdout)");
         cmd.add_option("--poses", poses, "Pose set (config/poses/NAME.toml, or a file)")->capture_default_str();
         cmd.add_option("--curves", curves, "Bigram curve set (config/curves/NAME.json, or a file)")
+            ->capture_default_str();
+        cmd.add_option("--runtime", runtime,
+                       "bigram: the phone-bigram curves (paper 000); filter: the viseme-space "
+                       "filter (paper 001, section 5), simpler and lower-latency")
+            ->check(CLI::IsMember({"bigram", "filter"}))
             ->capture_default_str();
         cmd.add_option("--character", character,
                        "Character file: a base curve set with some bigrams replaced");
@@ -49,6 +55,7 @@ struct RuntimeOptions {
 
     PoseTrack animate(const PhonemeSchedule& schedule) const {
         const auto loaded = load();
+        if (runtime == "filter") return lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config);
         return lipsync::animate(schedule, loaded.curves, loaded.poses, config);
     }
 

@@ -51,3 +51,20 @@ TEST(PhonemeMap, RejectsTargetsOutsideTheSetNamingLineAndKey) {
         EXPECT_NE(what.find("nonsense"), std::string::npos) << what;
     }
 }
+
+TEST(PhonemeMap, EnglishIpaCoversTheFortyPhonemesLikeArpabet) {
+    const auto ipa = PhonemeMap::named("ipa");
+    const auto arpabet = PhonemeMap::named("arpabet");
+    // The same sounds land in the same classes whichever alphabet names them.
+    const std::pair<const char*, const char*> same[] = {
+        {"æ", "AE"}, {"ɑ", "AA"}, {"ɔ", "AO"}, {"eɪ", "EY"}, {"ɝ", "ER"}, {"iː", "IY"}, {"uː", "UW"},
+        {"oʊ", "OW"}, {"aʊ", "AW"}, {"ɔɪ", "OY"}, {"aɪ", "AY"}, {"h", "HH"}, {"ɹ", "R"}, {"ʃ", "SH"},
+        {"tʃ", "CH"}, {"ð", "DH"}, {"v", "V"}, {"ŋ", "NG"}, {"ɡ", "G"}, {"m", "M"}};
+    for (const auto& [i, a] : same) {
+        ASSERT_TRUE(ipa.map(i)) << i;
+        EXPECT_EQ(ipa.map(i)->phoneme, arpabet.map(a)->phoneme) << i << " vs " << a;
+        EXPECT_FALSE(ipa.map(i)->approximate) << i;
+    }
+    EXPECT_TRUE(ipa.map("ɾ")->approximate);  // a flap is not one of the forty: nearest, warned
+    EXPECT_FALSE(ipa.map("ʘ"));              // a click: unknown
+}

@@ -11,6 +11,7 @@
 //   animate()        the runtime, offline: pairs → time-warp → stitch with max → valley
 //                    smoothing → constraints → speed limits, each step switchable.
 //   StreamingRuntime the same, fed segment by segment, with a fixed delay (or causal).
+//   animateFilter()  the viseme-space filter of paper 001, section 5: a second, simpler runtime.
 #pragma once
 
 #include <lipsyncd/core.hpp>
@@ -175,6 +176,14 @@ void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const floa
 PoseTrack animate(std::span<const PhonemeSegment> schedule, const BigramCurveSet& set,
                   const PoseSet& poses, const RuntimeConfig& config = {},
                   const PhonemeSet& phonemes = PhonemeSet::common());
+
+// The viseme-space filter of paper 001, section 5 (`--runtime filter`): per 10 ms slot the
+// pose vector of its phoneme, filtered a'_i = 0.1·a_i−1 + 0.5·a_i + 0.3·a_i+1 + 0.1·a_i+3 and
+// averaged down to the output rate. Each class's pose vector is what the curve set holds for
+// it (its self-bigram at the first phoneme's centre). Looks only 30 ms ahead.
+PoseTrack animateFilter(std::span<const PhonemeSegment> schedule, const BigramCurveSet& set,
+                        const PoseSet& poses, const RuntimeConfig& config = {},
+                        const PhonemeSet& phonemes = PhonemeSet::common());
 
 // Streaming: segments arrive as the front end closes them; weights leave with a fixed delay.
 // A frame at time t goes out once segments are closed up to t + delay. With a delay longer
