@@ -13,5 +13,6 @@ void addTrainCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);
 void addAnimateCommand(CLI::App& app);
 void addCurvesCommand(CLI::App& app);
+void addPlotCommand(CLI::App& app);
 
 }  // namespace lipsyncd::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
     addSayCommand(app);
     addAnimateCommand(app);
     addCurvesCommand(app);
+    addPlotCommand(app);
 
     try {
         app.parse(argc, argv);

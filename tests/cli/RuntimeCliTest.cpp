@@ -86,5 +86,31 @@ TEST(AnimateCli, AnalyzeGoesStraightFromAudioToWeights) {
     EXPECT_EQ(runLipsync({"analyze", wav.string()}).exitCode, 2);  // nothing to write
 }
 
+std::size_t count(const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+TEST(PlotCli, DrawsACurvePerPoseAndThePhonemesUnderThem) {
+    const auto dir = scratchDir("plot");
+    const auto weights = dir / "w.csv", schedule = dir / "s.tsv", svg = dir / "w.svg";
+    ASSERT_EQ(runLipsync({"say", "Bob & me", "--weights", weights.string(), "--schedule", schedule.string()}).exitCode, 0);
+    const auto r = runLipsync({"plot", "--weights", weights.string(), "--schedule", schedule.string(), "-o", svg.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto text = slurp(svg);
+    EXPECT_EQ(text.rfind("<?xml", 0), 0u);
+    EXPECT_NE(text.find("</svg>"), std::string::npos);
+    EXPECT_EQ(count(text, "<polyline class=\"pose\""), 9u);  // the FaceFX-style poses
+    EXPECT_NE(text.find("data-pose=\"pbm\""), std::string::npos);
+    EXPECT_EQ(count(text, "<text x=") - count(text, " s</text>") - 3 /* axis values */ - 9 /* legend */,
+              readScheduleFile(schedule).size());
+    // Bad input names the file.
+    std::ofstream(dir / "bad.csv") << "time,open\n0,0.1\n0.01\n";
+    const auto bad = runLipsync({"plot", "--weights", (dir / "bad.csv").string(), "-o", "-"});
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("bad.csv:3"), std::string::npos) << bad.err;
+}
+
 }  // namespace
 }  // namespace lipsyncd::test
