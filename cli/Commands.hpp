@@ -14,5 +14,6 @@ void addCalibrateCommand(CLI::App& app);
 void addAnimateCommand(CLI::App& app);
 void addCurvesCommand(CLI::App& app);
 void addPlotCommand(CLI::App& app);
+void addDriveCommands(CLI::App& app);  // drive, check, devices
 
 }  // namespace lipsyncd::cli

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
     addAnimateCommand(app);
     addCurvesCommand(app);
     addPlotCommand(app);
+    addDriveCommands(app);
 
     try {
         app.parse(argc, argv);
