@@ -96,7 +96,8 @@ void HidSink::write(double time, std::span<const ActuatorCommand> commands) {
         if (!device_) return;
         if (log_) log_("HID board '" + config_.name + "' is back");
     }
-    if (time - lastSent_ < 1.0 / config_.rateHz && time >= lastSent_) return;
+    // (a microsecond of slack: 0.03 − 0.01 is a hair under 0.02 in floating point)
+    if (time - lastSent_ < 1.0 / config_.rateHz - 1e-6 && time >= lastSent_) return;
     lastSent_ = time;
     const auto payload = std::span<std::uint8_t>(report_).subspan(1);
     for (const auto& [index, a] : channels_) encode(payload, a->hidChannel, commands[index].value, a->min, a->max, config_.encoding);
