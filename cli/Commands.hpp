@@ -15,5 +15,6 @@ void addAnimateCommand(CLI::App& app);
 void addCurvesCommand(CLI::App& app);
 void addPlotCommand(CLI::App& app);
 void addDriveCommands(CLI::App& app);  // drive, check, devices
+void addCtlCommand(CLI::App& app);
 
 }  // namespace lipsyncd::cli

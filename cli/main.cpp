@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     addCurvesCommand(app);
     addPlotCommand(app);
     addDriveCommands(app);
+    addCtlCommand(app);
 
     try {
         app.parse(argc, argv);

@@ -1,0 +1,106 @@
+// daemon: lipsyncd, the service. It plays what it analyses and drives the mouth from the audio
+// device's own clock, so sound and mouth stay together.
+//
+//   DaemonConfig   lipsyncd.toml: audio device, puppet, curves, templates, runtime, delays,
+//                  control socket (strict: unknown keys stop start-up with file and line).
+//   AudioSink      where sound goes, and how much of it has been heard: ALSA (the playback
+//                  position from snd_pcm_delay), null (a real-time clock, no device), a WAV file.
+//   Clip           one request made ready: the audio, and the pose weights computed from it
+//                  ahead of time (a file is analysed offline; text comes from espeak-ng).
+//   Player         the queue: plays clips one after another through the sink and drives the
+//                  puppet at the sink's clock plus the puppet's lead time and the sync offset.
+//   ControlServer  a Unix socket speaking JSON lines to many clients at once.
+//   Daemon         all of it in one poll() loop with sd_notify (READY, STATUS, WATCHDOG,
+//                  RELOADING, STOPPING), SIGHUP reload and SIGTERM rest-then-exit.
+#pragma once
+
+#include <lipsyncd/core.hpp>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace lipsyncd::daemon {
+
+struct DaemonConfig {
+    std::filesystem::path source;
+    // [audio]
+    std::string device = "default";  // an ALSA device, "null" (no sound), or "file:PATH.wav"
+    // [mouth]
+    std::string puppet = "terminal";
+    std::string poses = "facefx";
+    std::string curves = "english";
+    std::string character;
+    std::string runtime = "bigram";  // bigram | filter
+    std::string templates;           // empty: the shipped default
+    std::string voice = "en-us";
+    double leadSeconds = 0.05;       // drive the mouth this much ahead of the sound (servo lag)
+    double syncOffsetSeconds = 0;    // the user's correction, + moves the mouth later
+    bool hardware = true;            // open the puppet's GPIO/HID outputs
+    std::string record;              // also record every actuator command here (CSV)
+    bool terminal = false;           // show the actuators as bars on stderr
+    // [control]
+    std::filesystem::path socket = "/run/lipsyncd/control.sock";
+    unsigned socketMode = 0660;
+    double outputRateHz = 100;
+
+    static DaemonConfig load(const std::filesystem::path& file);  // InputError with file:line
+};
+
+class AudioSink {
+public:
+    virtual ~AudioSink() = default;
+    virtual void open(int rate) = 0;  // mono float at `rate`
+    // Takes what fits now without blocking; returns how many samples it took.
+    virtual std::size_t write(std::span<const float> samples) = 0;
+    // Samples heard so far (written minus what is still in the device's buffer).
+    virtual std::int64_t played() = 0;
+    virtual void stop() = 0;  // drop what is queued
+};
+// "null", "file:PATH.wav" or an ALSA device name; InputError naming the device if it cannot open.
+std::unique_ptr<AudioSink> openAudioSink(const std::string& device);
+
+struct Clip {
+    std::string name;
+    std::vector<float> samples;  // mono
+    int rate = 0;
+    PoseTrack weights;
+};
+
+// The pieces a request needs to become a Clip, loaded from the config at start and on reload.
+class ClipMaker {
+public:
+    explicit ClipMaker(const DaemonConfig& config);
+    ~ClipMaker();
+    Clip fromFile(const std::filesystem::path& file, int channel) const;
+    Clip fromText(const std::string& text, const std::string& voice);
+    const std::vector<std::string>& poseNames() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+class Daemon {
+public:
+    explicit Daemon(std::filesystem::path configFile);
+    ~Daemon();
+    // Runs until SIGTERM/SIGINT (or a "quit" request in tests): returns the exit code.
+    int run();
+    // One JSON request, one JSON reply (the socket's protocol; public for tests).
+    nlohmann::json handle(const nlohmann::json& request);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lipsyncd::daemon

@@ -1,0 +1,58 @@
+// lipsyncd.toml, read strictly (TomlTable): a typo stops start-up with the file, line and key.
+#include <lipsyncd/daemon.hpp>
+#include <lipsyncd/toml_table.hpp>
+
+namespace lipsyncd::daemon {
+
+namespace {
+double seconds(const TomlTable& t, const std::string& key, double fallback, double lo, double hi) {
+    const double v = t.optNumber(key).value_or(fallback);
+    if (!(v >= lo && v <= hi)) t.fail(key, "must be within " + std::to_string(lo) + " .. " + std::to_string(hi) + " s");
+    return v;
+}
+}  // namespace
+
+DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
+    DaemonConfig c;
+    c.source = file;
+    const auto root = TomlTable::parseFile(file);
+    if (const auto audio = root.optTable("audio")) {
+        c.device = audio->optString("device").value_or(c.device);
+        audio->finish();
+    }
+    if (const auto mouth = root.optTable("mouth")) {
+        c.puppet = mouth->optString("puppet").value_or(c.puppet);
+        c.poses = mouth->optString("poses").value_or(c.poses);
+        c.curves = mouth->optString("curves").value_or(c.curves);
+        c.character = mouth->optString("character").value_or("");
+        c.runtime = mouth->optString("runtime").value_or(c.runtime);
+        if (c.runtime != "bigram" && c.runtime != "filter") mouth->fail("runtime", "must be \"bigram\" or \"filter\"");
+        c.templates = mouth->optString("templates").value_or("");
+        c.voice = mouth->optString("voice").value_or(c.voice);
+        c.leadSeconds = seconds(*mouth, "lead", c.leadSeconds, -1, 1);
+        c.syncOffsetSeconds = seconds(*mouth, "sync_offset", 0, -2, 2);
+        c.hardware = mouth->optBool("hardware").value_or(true);
+        c.record = mouth->optString("record").value_or("");
+        c.terminal = mouth->optBool("terminal").value_or(false);
+        const double rate = mouth->optNumber("output_rate").value_or(100);
+        if (!(rate >= 10 && rate <= 1000)) mouth->fail("output_rate", "must be within 10 .. 1000 Hz");
+        c.outputRateHz = rate;
+        mouth->finish();
+    }
+    if (const auto control = root.optTable("control")) {
+        c.socket = control->optString("socket").value_or(c.socket.string());
+        const auto mode = control->optString("mode").value_or("0660");
+        try {
+            std::size_t used = 0;
+            c.socketMode = static_cast<unsigned>(std::stoul(mode, &used, 8));
+            if (used != mode.size() || c.socketMode > 0777) throw std::invalid_argument(mode);
+        } catch (const std::exception&) {
+            control->fail("mode", "must be an octal file mode such as \"0660\"");
+        }
+        control->finish();
+    }
+    root.finish();
+    return c;
+}
+
+}  // namespace lipsyncd::daemon
