@@ -14,7 +14,6 @@ struct ClipMaker::Impl {
     lipsync::BigramCurveSet curves;
     dsp::TemplateSet templates;
     std::vector<std::string> poseNames;
-    std::unique_ptr<EspeakSynthesizer> synth;  // created on first use (one per process)
 
     explicit Impl(const DaemonConfig& c)
         : config(c), poses(lipsync::PoseSet::named(c.poses)),
@@ -48,10 +47,9 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
     return clip;
 }
 
-Clip ClipMaker::fromText(const std::string& text, const std::string& voice) {
-    if (!impl_->synth) impl_->synth = std::make_unique<EspeakSynthesizer>();
+Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice) const {
     const auto v = voice.empty() ? impl_->config.voice : voice;
-    const auto speech = impl_->synth->synthesize({text, v, 0, -1});
+    const auto speech = synth.synthesize({text, v, 0, -1});
     Clip clip;
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;

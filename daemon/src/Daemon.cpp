@@ -4,6 +4,7 @@
 // stalled loop is a missed watchdog and systemd restarts the service.
 #include <lipsyncd/daemon.hpp>
 #include <lipsyncd/output.hpp>
+#include <lipsyncd/tts.hpp>
 
 #include "ControlServer.hpp"
 
@@ -73,6 +74,7 @@ struct Daemon::Impl {
     std::filesystem::path configFile;
     std::unique_ptr<Setup> setup;
     std::unique_ptr<ControlServer> control;
+    std::unique_ptr<EspeakSynthesizer> synth;  // made on the first say, kept across reloads
     std::deque<Clip> queue;
     std::optional<Clip> current;
     std::size_t written = 0;       // samples of the current clip handed to the device
@@ -190,7 +192,8 @@ struct Daemon::Impl {
             }
             if (cmd == "say") {
                 if (!r.contains("text") || !r["text"].is_string()) return {{"ok", false}, {"error", "say needs \"text\""}};
-                queue.push_back(setup->clips->fromText(r["text"].get<std::string>(), r.value("voice", std::string())));
+                if (!synth) synth = std::make_unique<EspeakSynthesizer>();
+                queue.push_back(setup->clips->fromText(*synth, r["text"].get<std::string>(), r.value("voice", std::string())));
                 return {{"ok", true}, {"queued", queue.back().name}};
             }
             if (cmd == "stop") {

@@ -28,6 +28,10 @@
 #include <string>
 #include <vector>
 
+namespace lipsyncd {
+class EspeakSynthesizer;
+}
+
 namespace lipsyncd::daemon {
 
 struct DaemonConfig {
@@ -81,7 +85,8 @@ public:
     explicit ClipMaker(const DaemonConfig& config);
     ~ClipMaker();
     Clip fromFile(const std::filesystem::path& file, int channel) const;
-    Clip fromText(const std::string& text, const std::string& voice);
+    // espeak-ng allows one synthesiser per process, for the process's life: the daemon owns it.
+    Clip fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice) const;
     const std::vector<std::string>& poseNames() const;
 
 private:

@@ -1,0 +1,299 @@
+// lipsyncd as systemd runs it: a subprocess with a test NOTIFY_SOCKET, the null or file audio
+// device and the recorder, driven over its control socket.
+#include "../cli/RunLipsync.hpp"
+
+#include <lipsyncd/core.hpp>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+namespace lipsyncd::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+// A datagram socket standing in for systemd's notification socket.
+class NotifySocket {
+public:
+    explicit NotifySocket(const fs::path& path) : path_(path) {
+        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        sockaddr_un a{};
+        a.sun_family = AF_UNIX;
+        std::strncpy(a.sun_path, path.c_str(), sizeof(a.sun_path) - 1);
+        ::unlink(path.c_str());
+        EXPECT_EQ(::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+        timeval tv{0, 200'000};
+        ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    }
+    ~NotifySocket() { ::close(fd_); }
+    // Waits up to `timeout` for a message containing `what`; returns everything received.
+    bool waitFor(const std::string& what, std::chrono::milliseconds timeout = 10s) {
+        const auto end = std::chrono::steady_clock::now() + timeout;
+        while (std::chrono::steady_clock::now() < end) {
+            char buf[4096];
+            const auto n = ::recv(fd_, buf, sizeof buf, 0);
+            if (n > 0) received.emplace_back(buf, static_cast<std::size_t>(n));
+            for (const auto& m : received)
+                if (m.find(what) != std::string::npos) return true;
+        }
+        return false;
+    }
+    std::vector<std::string> received;
+
+private:
+    fs::path path_;
+    int fd_;
+};
+
+class Client {
+public:
+    explicit Client(const fs::path& path) {
+        for (int i = 0; i < 100 && fd_ < 0; ++i) {
+            fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+            sockaddr_un a{};
+            a.sun_family = AF_UNIX;
+            std::strncpy(a.sun_path, path.c_str(), sizeof(a.sun_path) - 1);
+            if (::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) break;
+            ::close(fd_);
+            fd_ = -1;
+            std::this_thread::sleep_for(50ms);
+        }
+    }
+    ~Client() {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    bool connected() const { return fd_ >= 0; }
+    void sendLine(const std::string& line) { ::send(fd_, (line + "\n").data(), line.size() + 1, MSG_NOSIGNAL); }
+    std::string readLine() {
+        for (;;) {
+            const auto nl = buf_.find('\n');
+            if (nl != std::string::npos) {
+                auto l = buf_.substr(0, nl);
+                buf_.erase(0, nl + 1);
+                return l;
+            }
+            char b[4096];
+            const auto n = ::read(fd_, b, sizeof b);
+            if (n <= 0) return "";
+            buf_.append(b, static_cast<std::size_t>(n));
+        }
+    }
+    json request(const json& r) {
+        sendLine(r.dump());
+        return json::parse(readLine());
+    }
+
+private:
+    int fd_ = -1;
+    std::string buf_;
+};
+
+struct DaemonProcess {
+    fs::path dir = scratchDir("daemon");
+    pid_t pid = -1;
+
+    explicit DaemonProcess(const std::string& extraMouth = "", const std::string& device = "null") {
+        std::ofstream(dir / "lipsyncd.toml") << "[audio]\ndevice = \"" << device << "\"\n[mouth]\npuppet = \"terminal\"\n"
+                                              << "hardware = false\nrecord = \"" << (dir / "rec.csv").string() << "\"\n"
+                                              << extraMouth << "[control]\nsocket = \"" << (dir / "control.sock").string()
+                                              << "\"\n";
+    }
+    void start() {
+        ::setenv("NOTIFY_SOCKET", (dir / "notify").c_str(), 1);
+        std::vector<std::string> args{LIPSYNCD_DAEMON_BIN, "--config", (dir / "lipsyncd.toml").string()};
+        std::vector<char*> argv;
+        for (auto& a : args) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_addopen(&actions, 2, (dir / "stderr.log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
+        posix_spawn_file_actions_destroy(&actions);
+        ::unsetenv("NOTIFY_SOCKET");
+    }
+    int stop(int signal = SIGTERM) {
+        ::kill(pid, signal);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        pid = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    ~DaemonProcess() {
+        if (pid > 0) stop(SIGKILL);
+    }
+    long rssKiB() const {
+        std::ifstream s("/proc/" + std::to_string(pid) + "/status");
+        for (std::string line; std::getline(s, line);)
+            if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+        return -1;
+    }
+    // (time, value) of one actuator from the recorder.
+    std::vector<std::pair<double, double>> recorded(const std::string& actuator) const {
+        std::ifstream in(dir / "rec.csv");
+        std::vector<std::pair<double, double>> out;
+        std::string line;
+        std::getline(in, line);
+        while (std::getline(in, line)) {
+            const auto a = line.find(','), b = line.find(',', a + 1), c = line.find(',', b + 1);
+            if (line.substr(a + 1, b - a - 1) == actuator) out.emplace_back(std::stod(line.substr(0, a)), std::stod(line.substr(b + 1, c - b - 1)));
+        }
+        return out;
+    }
+};
+
+void waitUntilIdle(Client& c, std::chrono::seconds timeout = 20s) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < end) {
+        const auto s = c.request({{"cmd", "status"}});
+        if (s["playing"].is_null() && s["queue"].empty()) return;
+        std::this_thread::sleep_for(50ms);
+    }
+    FAIL() << "still playing after " << timeout.count() << " s";
+}
+
+TEST(Daemon, NotifiesSystemdReloadsOnSighupAndRestsOnSigterm) {
+    DaemonProcess d;
+    NotifySocket notify(d.dir / "notify");
+    d.start();
+    ASSERT_TRUE(notify.waitFor("READY=1")) << "no READY=1";
+    EXPECT_TRUE(notify.waitFor("STATUS=ready"));
+    Client c(d.dir / "control.sock");
+    ASSERT_TRUE(c.connected());
+    EXPECT_TRUE(c.request({{"cmd", "say"}, {"text", "Open wide."}})["ok"]);
+    waitUntilIdle(c);
+    // SIGHUP: RELOADING=1, then READY=1 again; the socket stays open.
+    std::ofstream(d.dir / "lipsyncd.toml", std::ios::app) << "";
+    ::kill(d.pid, SIGHUP);
+    EXPECT_TRUE(notify.waitFor("RELOADING=1"));
+    EXPECT_TRUE(c.request({{"cmd", "status"}})["ok"]);
+    // SIGTERM: the mouth goes to rest, then the process exits 0.
+    EXPECT_TRUE(c.request({{"cmd", "say"}, {"text", "Hello hello hello hello."}})["ok"]);
+    std::this_thread::sleep_for(400ms);
+    EXPECT_EQ(d.stop(SIGTERM), 0);
+    EXPECT_TRUE(notify.waitFor("STOPPING=1"));
+    const auto jaw = d.recorded("jaw");
+    ASSERT_FALSE(jaw.empty());
+    double peak = 0;
+    for (const auto& [t, v] : jaw) peak = std::max(peak, v);
+    EXPECT_GT(peak, 0.2) << "the jaw never moved";
+    EXPECT_EQ(jaw.back().second, 0.0) << "not at rest after SIGTERM";
+}
+
+TEST(Daemon, MalformedConfigStopsStartupWithTheLine) {
+    const auto dir = scratchDir("daemon_badconf");
+    std::ofstream(dir / "bad.toml") << "[audio]\ndevice = \"null\"\n[mouth]\npupet = \"terminal\"\n";
+    const auto r = runProgram(LIPSYNCD_DAEMON_BIN, {"--config", (dir / "bad.toml").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("bad.toml:4"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("pupet"), std::string::npos) << r.err;
+}
+
+TEST(Daemon, PlayedFileDrivesTheMouthAsTheOfflinePassDoes) {
+    DaemonProcess d("lead = 0.0\n", "file:" + (scratchDir("daemon_audio") / "out.wav").string());
+    d.start();
+    Client c(d.dir / "control.sock");
+    ASSERT_TRUE(c.connected());
+    const auto example = findDataFile("examples/hello.wav");
+    const auto reply = c.request({{"cmd", "play"}, {"file", example.string()}});
+    ASSERT_TRUE(reply["ok"]) << reply.dump();
+    waitUntilIdle(c);
+    EXPECT_EQ(d.stop(), 0);
+    // Offline: the same audio, analysed and driven through the same puppet.
+    const auto off = d.dir / "offline";
+    fs::create_directories(off);
+    ASSERT_EQ(runLipsync({"analyze", example.string(), "--weights", (off / "w.csv").string(), "-q"}).exitCode, 0);
+    ASSERT_EQ(runLipsync({"drive", "--weights", (off / "w.csv").string(), "--puppet", "terminal", "--no-hardware",
+                          "--record", (off / "rec.csv").string()}).exitCode, 0);
+    std::vector<double> offline;
+    {
+        std::ifstream in(off / "rec.csv");
+        std::string line;
+        std::getline(in, line);
+        while (std::getline(in, line))
+            if (line.find(",jaw,") != std::string::npos) offline.push_back(std::stod(line.substr(line.find(",jaw,") + 5)));
+    }
+    // The daemon's jaw while the clip played, resampled onto 10 ms steps from its first movement.
+    const auto live = d.recorded("jaw");
+    ASSERT_GT(live.size(), 100u);
+    std::vector<double> daemon;
+    std::size_t i = 0;
+    const double t0 = live.front().first;
+    for (double t = t0; t < live.back().first; t += 0.01) {
+        while (i + 1 < live.size() && live[i + 1].first <= t) ++i;
+        daemon.push_back(live[i].second);
+    }
+    // Best agreement within ±150 ms of lag (start-up and the device clock's granularity).
+    double best = 1e9;
+    for (int lag = -15; lag <= 15; ++lag) {
+        double err = 0;
+        std::size_t n = 0;
+        for (std::size_t k = 0; k < offline.size(); ++k) {
+            const long j = static_cast<long>(k) + lag;
+            if (j < 0 || j >= static_cast<long>(daemon.size())) continue;
+            err += std::abs(daemon[static_cast<std::size_t>(j)] - offline[k]);
+            ++n;
+        }
+        if (n > offline.size() / 2) best = std::min(best, err / static_cast<double>(n));
+    }
+    EXPECT_LT(best, 0.05) << "mean |daemon − offline| jaw difference at the best lag";
+}
+
+TEST(Daemon, ManyClientsAndMalformedRequestsLoseNothingAndMemoryStaysFlat) {
+    DaemonProcess d;
+    d.start();
+    {
+        Client warm(d.dir / "control.sock");
+        ASSERT_TRUE(warm.connected());
+        warm.request({{"cmd", "status"}});
+    }
+    std::this_thread::sleep_for(200ms);
+    const long before = d.rssKiB();
+    std::vector<std::thread> threads;
+    std::atomic<int> good{0}, refused{0}, lost{0};
+    for (int t = 0; t < 4; ++t)
+        threads.emplace_back([&, t] {
+            Client c(d.dir / "control.sock");
+            for (int i = 0; i < 80; ++i) {
+                std::string line;
+                switch ((i + t) % 5) {
+                    case 0: line = R"({"cmd":"status"})"; break;
+                    case 1: line = "{broken json"; break;
+                    case 2: line = R"({"cmd":"frobnicate"})"; break;
+                    case 3: line = R"({"cmd":"play","file":"/nonexistent.wav"})"; break;
+                    default: line = R"([1,2,3])"; break;
+                }
+                c.sendLine(line);
+                const auto reply = c.readLine();
+                if (reply.empty()) {
+                    ++lost;
+                    continue;
+                }
+                json::parse(reply)["ok"].get<bool>() ? ++good : ++refused;
+            }
+        });
+    for (auto& t : threads) t.join();
+    EXPECT_EQ(lost.load(), 0);
+    EXPECT_EQ(good.load(), 4 * 16);
+    EXPECT_EQ(refused.load(), 4 * 64);
+    const long after = d.rssKiB();
+    EXPECT_LT(after - before, 4096) << "RSS grew from " << before << " to " << after << " KiB";
+    Client c(d.dir / "control.sock");
+    EXPECT_TRUE(c.request({{"cmd", "status"}})["ok"]);  // and it is still there
+    EXPECT_EQ(d.stop(), 0);
+}
+
+}  // namespace
+}  // namespace lipsyncd::test
