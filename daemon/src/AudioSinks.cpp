@@ -122,3 +122,70 @@ std::unique_ptr<AudioSink> openAudioSink(const std::string& device) {
 }
 
 }  // namespace lipsyncd::daemon
+
+namespace lipsyncd::daemon {
+
+namespace {
+class AlsaCapture : public CaptureSource {
+public:
+    AlsaCapture(const std::string& device, int rate) : rate_(rate) {
+        if (snd_pcm_open(&pcm_, device.c_str(), SND_PCM_STREAM_CAPTURE, SND_PCM_NONBLOCK) < 0)
+            throw InputError("capture device '" + device + "': cannot open (no sound card or microphone?)");
+        const int err = snd_pcm_set_params(pcm_, SND_PCM_FORMAT_FLOAT_LE, SND_PCM_ACCESS_RW_INTERLEAVED, 1,
+                                           static_cast<unsigned>(rate), 1, 40'000);
+        if (err < 0) {
+            snd_pcm_close(pcm_);
+            throw InputError("capture device '" + device + "': " + snd_strerror(err));
+        }
+        snd_pcm_start(pcm_);
+    }
+    ~AlsaCapture() override { snd_pcm_close(pcm_); }
+    int rate() const override { return rate_; }
+    std::size_t read(std::span<float> out) override {
+        const auto n = snd_pcm_readi(pcm_, out.data(), out.size());
+        if (n == -EAGAIN) return 0;
+        if (n < 0) {
+            snd_pcm_recover(pcm_, static_cast<int>(n), 1);
+            return 0;
+        }
+        return static_cast<std::size_t>(n);
+    }
+
+private:
+    snd_pcm_t* pcm_ = nullptr;
+    int rate_;
+};
+
+// A WAV file that arrives at real-time pace from the moment it is opened, then silence.
+class FileCapture : public CaptureSource {
+public:
+    FileCapture(const std::string& path, int) {
+        const auto audio = dsp::readAudioFile(path);
+        samples_ = audio.samples;
+        rate_ = audio.sampleRate;
+        start_ = std::chrono::steady_clock::now();
+    }
+    int rate() const override { return rate_; }
+    std::size_t read(std::span<float> out) override {
+        const auto due = static_cast<std::size_t>(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() * rate_);
+        const std::size_t n = std::min(out.size(), due > given_ ? due - given_ : 0);
+        for (std::size_t i = 0; i < n; ++i) out[i] = given_ + i < samples_.size() ? samples_[given_ + i] : 0.0f;
+        given_ += n;
+        return n;
+    }
+
+private:
+    std::vector<float> samples_;
+    int rate_ = 16000;
+    std::size_t given_ = 0;
+    std::chrono::steady_clock::time_point start_;
+};
+}  // namespace
+
+std::unique_ptr<CaptureSource> openCaptureSource(const std::string& device, int rate) {
+    if (device.rfind("file:", 0) == 0) return std::make_unique<FileCapture>(device.substr(5), rate);
+    return std::make_unique<AlsaCapture>(device, rate);
+}
+
+}  // namespace lipsyncd::daemon

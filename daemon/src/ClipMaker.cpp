@@ -59,3 +59,48 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text, cons
 }
 
 }  // namespace lipsyncd::daemon
+
+namespace lipsyncd::daemon {
+
+namespace {
+// The front end streaming into the bigram runtime in its causal mode: weights for everything
+// up to the last closed phoneme go out as soon as the phoneme closes.
+class StreamingLive : public ClipMaker::Live {
+public:
+    StreamingLive(const dsp::TemplateSet& templates, const lipsync::BigramCurveSet& curves,
+                  const lipsync::PoseSet& poses, double outputRate, int rate)
+        : analyzer_(templates, PhonemeSet::common(), rate), runtime_(curves, poses, 0, config(outputRate)) {
+        analyzer_.onSegment([this](const PhonemeSegment& s) { runtime_.push(s, *out_); });
+        // The newest frame's class stands for the phoneme still open (the segmenter has not
+        // closed it yet): the mouth starts moving without waiting for the phoneme to end.
+        analyzer_.onFrame([this](const dsp::StreamingAnalyzer::Frame& f) {
+            openPhoneme_ = PhonemeSet::common()[static_cast<std::size_t>(f.label.phoneme)].name;
+            openUntil_ = f.label.time;
+        });
+    }
+    void push(std::span<const float> samples, PoseTrack& out) override {
+        out_ = &out;
+        analyzer_.push(samples);
+        if (!openPhoneme_.empty()) runtime_.preview(openPhoneme_, openUntil_, out);
+    }
+    double latencySeconds() const override { return analyzer_.latencySeconds(); }
+
+private:
+    static lipsync::RuntimeConfig config(double rate) {
+        lipsync::RuntimeConfig c;
+        c.outputRate = rate;
+        return c;
+    }
+    dsp::StreamingAnalyzer analyzer_;
+    lipsync::StreamingRuntime runtime_;
+    PoseTrack* out_ = nullptr;
+    std::string openPhoneme_;
+    double openUntil_ = 0;
+};
+}  // namespace
+
+std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
+    return std::make_unique<StreamingLive>(impl_->templates, impl_->curves, impl_->poses, impl_->config.outputRateHz, rate);
+}
+
+}  // namespace lipsyncd::daemon

@@ -75,6 +75,12 @@ struct Daemon::Impl {
     std::unique_ptr<Setup> setup;
     std::unique_ptr<ControlServer> control;
     std::unique_ptr<EspeakSynthesizer> synth;  // made on the first say, kept across reloads
+    // Live: capture → streaming front end → causal runtime → the mouth, with the least delay.
+    std::unique_ptr<CaptureSource> capture;
+    std::unique_ptr<ClipMaker::Live> live;
+    PoseTrack liveFrames;
+    std::vector<float> captureBuffer = std::vector<float>(96000);
+    double liveStarted = -1;
     std::deque<Clip> queue;
     std::optional<Clip> current;
     std::size_t written = 0;       // samples of the current clip handed to the device
@@ -107,9 +113,42 @@ struct Daemon::Impl {
         return current ? static_cast<double>(setup->audio->played() - playedBase) / current->rate : 0;
     }
 
+    // New live weights since the last tick: the mouth takes the newest (the slew limit smooths).
+    bool tickLive(double t) {
+        if (!live) return false;
+        const auto n = capture->read(captureBuffer);
+        live->push(std::span<const float>(captureBuffer).first(n), liveFrames);
+        if (liveFrames.frames() > 0) {
+            setup->driver->update(t, liveFrames.frame(liveFrames.frames() - 1));
+            liveFrames.times.clear();  // keep memory flat: only the newest frame matters
+            liveFrames.values.clear();
+        } else {
+            setup->driver->tick(t);
+        }
+        return true;
+    }
+
+    json setLive(bool on) {
+        if (!on) {
+            live.reset();
+            capture.reset();
+            status("live off");
+            return {{"ok", true}, {"live", false}};
+        }
+        if (!live) {
+            capture = openCaptureSource(setup->config.captureDevice, setup->config.captureRate);
+            live = setup->clips->startLive(capture->rate());
+            liveFrames = PoseTrack{};
+            liveStarted = now();
+            status("live from " + setup->config.captureDevice);
+        }
+        return {{"ok", true}, {"live", true}, {"started", liveStarted}, {"front_end_latency", live->latencySeconds()}};
+    }
+
     void tick() {
         const double t = now();
         startNext();
+        const bool following = tickLive(t);
         if (current) {
             written += setup->audio->write(std::span<const float>(current->samples).subspan(written));
             // The mouth leads the sound by the puppet's lead time; the user's offset moves it.
@@ -118,14 +157,14 @@ struct Daemon::Impl {
             if (w.frames() > 0) {
                 const auto f = static_cast<std::size_t>(std::clamp(std::round(at * setup->config.outputRateHz), 0.0,
                                                                    static_cast<double>(w.frames() - 1)));
-                setup->driver->update(t, w.frame(f));
+                if (!following) setup->driver->update(t, w.frame(f));
             }
             if (written >= current->samples.size() && heard() >= static_cast<double>(current->samples.size()) / current->rate) {
                 ++clipsPlayed;
                 current.reset();
                 if (queue.empty()) status("idle");
             }
-        } else {
+        } else if (!following) {
             setup->driver->tick(t);  // idle: the mouth rests once input has stalled
         }
         if (control && control->clients() > 0 && t - lastEvent >= 0.04) {
@@ -161,7 +200,8 @@ struct Daemon::Impl {
                 {"played", clipsPlayed},
                 {"puppet", setup->puppet->name},
                 {"at_rest", setup->driver->atRest()},
-                {"live", false}};
+                {"live", live != nullptr},
+                {"live_started", liveStarted}};
     }
 
     void reload() {
@@ -174,6 +214,8 @@ struct Daemon::Impl {
             });
             queue.clear();
             current.reset();
+            live.reset();
+            capture.reset();
             setup = std::move(fresh);
             status("reloaded; idle");
         } catch (const std::exception& e) {
@@ -208,7 +250,7 @@ struct Daemon::Impl {
                 reload();
                 return {{"ok", true}, {"config", configFile.string()}};
             }
-            if (cmd == "live") return {{"ok", false}, {"error", "live capture is not available in this build yet"}};
+            if (cmd == "live") return setLive(r.value("on", true));
             if (cmd == "quit" && std::getenv("LIPSYNCD_TEST_QUIT")) {
                 quit = true;
                 return {{"ok", true}};

@@ -39,6 +39,13 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         c.outputRateHz = rate;
         mouth->finish();
     }
+    if (const auto live = root.optTable("live")) {
+        c.captureDevice = live->optString("device").value_or(c.captureDevice);
+        const double rate = live->optNumber("rate").value_or(16000);
+        if (!(rate >= 8000 && rate <= 96000)) live->fail("rate", "must be within 8000 .. 96000 Hz");
+        c.captureRate = static_cast<int>(rate);
+        live->finish();
+    }
     if (const auto control = root.optTable("control")) {
         c.socket = control->optString("socket").value_or(c.socket.string());
         const auto mode = control->optString("mode").value_or("0660");

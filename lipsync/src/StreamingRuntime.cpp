@@ -20,7 +20,7 @@ void StreamingRuntime::push(const PhonemeSegment& segment, PoseTrack& out) {
     if (!started_) {
         started_ = true;
         origin_ = segment.start;
-    } else if (std::abs(segment.start - window_.back().end) > 1e-6) {
+    } else if (!window_.empty() && std::abs(segment.start - window_.back().end) > 1e-6) {
         throw InputError("streaming schedule: segment at " + std::to_string(segment.start) +
                          " s does not start where the previous one ended (" +
                          std::to_string(window_.back().end) + " s)");
@@ -29,20 +29,34 @@ void StreamingRuntime::push(const PhonemeSegment& segment, PoseTrack& out) {
     emitUntil(segment.end - delay_, false, out);
 }
 
+void StreamingRuntime::preview(const std::string& phoneme, double until, PoseTrack& out) {
+    if (delay_ > 0) return;
+    if (!started_) {
+        started_ = true;
+        origin_ = 0;
+    }
+    const double from = window_.empty() ? origin_ : window_.back().end;
+    if (!(until > from)) return;
+    const PhonemeSegment open{from, until, phoneme, 0};
+    emitUntil(until, false, out, &open);
+}
+
 void StreamingRuntime::finish(PoseTrack& out) {
     if (!window_.empty()) emitUntil(window_.back().end, true, out);
 }
 
-void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out) {
+void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out, const PhonemeSegment* open) {
     if (out.poses.empty()) out.poses = poses_->names();
+    if (window_.empty() && !open) return;
     const double rate = config_.outputRate;
     const auto lastFrame = static_cast<long long>(std::floor((until - origin_) * rate + 1e-9));
     if (lastFrame < static_cast<long long>(emitted_)) return;
-    const auto firstFrame = static_cast<std::size_t>(
-        std::max(0.0, std::ceil((window_.front().start - origin_) * rate - 1e-9)));
+    const double windowStart = window_.empty() ? open->start : window_.front().start;
+    const auto firstFrame = static_cast<std::size_t>(std::max(0.0, std::ceil((windowStart - origin_) * rate - 1e-9)));
     // Work past the last frame to let out by a smoothing window, so that a curve cut short
     // there does not look like a peak to the valley smoothing.
-    const auto known = static_cast<long long>(std::floor((window_.back().end - origin_) * rate + 1e-9));
+    const double knownEnd = open ? open->end : window_.back().end;
+    const auto known = static_cast<long long>(std::floor((knownEnd - origin_) * rate + 1e-9));
     const auto margin = static_cast<long long>(std::ceil(longestWindow() * rate)) + 2;
     const auto workTo = final ? lastFrame : std::min(known, lastFrame + margin);
     const std::size_t frames = static_cast<std::size_t>(workTo) + 1 - firstFrame;
@@ -50,11 +64,16 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out) {
 
     std::vector<PhonemeSegment> schedule(window_.begin(), window_.end());
     const bool causal = delay_ == 0 && !final;
-    if (causal) {  // the next phoneme is unknown: assume this one goes on, for a typical length
+    if (causal) {  // what comes next is unknown: assume the last phoneme goes on, for a typical length
         double total = 0;
         for (const auto& s : window_) total += s.duration();
-        const auto& last = window_.back();
-        schedule.push_back({last.end, last.end + total / static_cast<double>(window_.size()), last.phoneme, 0});
+        const double typical = window_.empty() ? 0.1 : total / static_cast<double>(window_.size());
+        if (open) {
+            schedule.push_back({open->start, std::max(open->end, open->start + typical), open->phoneme, 0});
+        } else {
+            const auto& last = window_.back();
+            schedule.push_back({last.end, last.end + typical, last.phoneme, 0});
+        }
     }
     stitchBigrams(schedule, *set_, *phonemes_, curves, {atStart_, final});
     if (config_.smoothing)

@@ -11,6 +11,7 @@
 #include <sys/un.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
@@ -293,6 +294,58 @@ TEST(Daemon, ManyClientsAndMalformedRequestsLoseNothingAndMemoryStaysFlat) {
     Client c(d.dir / "control.sock");
     EXPECT_TRUE(c.request({{"cmd", "status"}})["ok"]);  // and it is still there
     EXPECT_EQ(d.stop(), 0);
+}
+
+// 16-bit mono WAV: `silence` seconds, then a 120 Hz buzz (a voiced sound) for `sound` seconds.
+void writeOnsetWav(const fs::path& path, double silence, double sound, int rate = 16000) {
+    std::vector<std::int16_t> pcm(static_cast<std::size_t>((silence + sound + 1.0) * rate), 0);
+    const auto from = static_cast<std::size_t>(silence * rate), to = static_cast<std::size_t>((silence + sound) * rate);
+    for (std::size_t i = from; i < to; ++i) {
+        double v = 0;
+        for (int h = 1; h <= 20; ++h) v += std::sin(2 * M_PI * 120 * h * static_cast<double>(i) / rate) / h * (h == 6 || h == 10 ? 3 : 1);
+        pcm[i] = static_cast<std::int16_t>(std::clamp(v * 4000, -32000.0, 32000.0));
+    }
+    std::ofstream out(path, std::ios::binary);
+    const auto put = [&](std::uint32_t v, int bytes) { out.write(reinterpret_cast<const char*>(&v), bytes); };
+    const auto data = static_cast<std::uint32_t>(pcm.size() * 2);
+    out << "RIFF";
+    put(36 + data, 4);
+    out << "WAVEfmt ";
+    put(16, 4), put(1, 2), put(1, 2), put(static_cast<std::uint32_t>(rate), 4), put(static_cast<std::uint32_t>(rate * 2), 4), put(2, 2), put(16, 2);
+    out << "data";
+    put(data, 4);
+    out.write(reinterpret_cast<const char*>(pcm.data()), data);
+}
+
+TEST(Daemon, LiveCaptureMovesTheMouthSoonAfterASoundStarts) {
+    const auto dir = scratchDir("daemon_live");
+    writeOnsetWav(dir / "onset.wav", 1.0, 0.6);
+    DaemonProcess d("", "null");
+    std::ofstream(d.dir / "lipsyncd.toml", std::ios::app) << "[live]\ndevice = \"file:" << (dir / "onset.wav").string() << "\"\n";
+    d.start();
+    Client c(d.dir / "control.sock");
+    ASSERT_TRUE(c.connected());
+    const auto on = c.request({{"cmd", "live"}, {"on", true}});
+    ASSERT_TRUE(on["ok"]) << on.dump();
+    std::this_thread::sleep_for(2500ms);
+    EXPECT_TRUE(c.request({{"cmd", "status"}})["live"]);
+    EXPECT_TRUE(c.request({{"cmd", "live"}, {"on", false}})["ok"]);
+    EXPECT_EQ(d.stop(), 0);
+    // The first command that leaves rest, measured from the sound's onset in the capture.
+    const double onset = on["started"].get<double>() + 1.0;
+    double first = -1;
+    for (const auto* name : {"jaw", "lips_round", "lips_closed", "tongue"})
+        for (const auto& [t, v] : d.recorded(name))
+            if (t > onset - 0.5 && v > 0.01) {
+                if (first < 0 || t < first) first = t;
+                break;
+            }
+    ASSERT_GT(first, 0) << "the mouth never moved on live input";
+    const double latency = first - onset;
+    std::cout << "live latency (onset -> first actuator command): " << latency * 1000 << " ms (front end bound "
+              << on["front_end_latency"].get<double>() * 1000 << " ms)\n";
+    EXPECT_GT(latency, 0.0) << "moved before the sound";
+    EXPECT_LT(latency, 0.6);
 }
 
 }  // namespace

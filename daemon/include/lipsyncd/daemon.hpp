@@ -51,6 +51,9 @@ struct DaemonConfig {
     bool hardware = true;            // open the puppet's GPIO/HID outputs
     std::string record;              // also record every actuator command here (CSV)
     bool terminal = false;           // show the actuators as bars on stderr
+    // [live]
+    std::string captureDevice = "default";  // an ALSA capture device, or "file:PATH.wav" (tests)
+    int captureRate = 16000;
     // [control]
     std::filesystem::path socket = "/run/lipsyncd/control.sock";
     unsigned socketMode = 0660;
@@ -72,6 +75,16 @@ public:
 // "null", "file:PATH.wav" or an ALSA device name; InputError naming the device if it cannot open.
 std::unique_ptr<AudioSink> openAudioSink(const std::string& device);
 
+// Live sound in: samples as they arrive, never blocking. ALSA capture, or a WAV file delivered
+// at real-time pace (what tests and latency measurements use).
+class CaptureSource {
+public:
+    virtual ~CaptureSource() = default;
+    virtual int rate() const = 0;
+    virtual std::size_t read(std::span<float> out) = 0;  // what has arrived (0 when nothing)
+};
+std::unique_ptr<CaptureSource> openCaptureSource(const std::string& device, int rate);
+
 struct Clip {
     std::string name;
     std::vector<float> samples;  // mono
@@ -88,10 +101,21 @@ public:
     // espeak-ng allows one synthesiser per process, for the process's life: the daemon owns it.
     Clip fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice) const;
     const std::vector<std::string>& poseNames() const;
+    // The live path: front end and runtime in their streaming forms (causal: least delay).
+    class Live;
+    std::unique_ptr<Live> startLive(int rate) const;
 
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
+};
+
+class ClipMaker::Live {
+public:
+    virtual ~Live() = default;
+    // Feeds captured samples; appends the weight frames that became final to `out`.
+    virtual void push(std::span<const float> samples, PoseTrack& out) = 0;
+    virtual double latencySeconds() const = 0;  // the front end's reported bound
 };
 
 class Daemon {

@@ -199,10 +199,14 @@ public:
     // Appends the frames that became final to `out` (out.poses must be the pose names).
     void push(const PhonemeSegment& segment, PoseTrack& out);
     void finish(PoseTrack& out);
+    // Causal mode only: the phoneme still being spoken (not yet closed) is `phoneme` up to
+    // `until`; frames up to `until` go out now, warped as if it lasts as long as the phonemes
+    // so far on average. When it closes, push() carries on from there with the truth.
+    void preview(const std::string& phoneme, double until, PoseTrack& out);
     double delaySeconds() const { return delay_; }
 
 private:
-    void emitUntil(double until, bool final, PoseTrack& out);
+    void emitUntil(double until, bool final, PoseTrack& out, const PhonemeSegment* open = nullptr);
     void dropOldSegments();
     double longestWindow() const;
 
