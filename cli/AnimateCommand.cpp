@@ -17,7 +17,7 @@ struct AnimateOptions {
 };
 
 void runAnimate(const AnimateOptions& o) {
-    const auto schedule = readLabels(o.schedule, o.labels);
+    const auto schedule = readLabels(o.schedule, o.labels, &o.runtime.phonemeSet());
     if (o.delay >= 0 && o.runtime.runtime != "bigram")
         throw CLI::ValidationError("--delay", "streaming is for --runtime bigram");
     if (o.delay < 0) {
@@ -26,7 +26,7 @@ void runAnimate(const AnimateOptions& o) {
     }
     // Streaming, as the daemon runs it: segment by segment, with the given delay.
     const auto loaded = o.runtime.load();
-    lipsync::StreamingRuntime stream(loaded.curves, loaded.poses, o.delay, o.runtime.config);
+    lipsync::StreamingRuntime stream(loaded.curves, loaded.poses, o.delay, o.runtime.config, o.runtime.phonemeSet());
     PoseTrack track;
     for (const auto& s : schedule) stream.push(s, track);
     stream.finish(track);
@@ -37,6 +37,8 @@ struct GenerateOptions {
     std::string rules = "curves/english-rules.toml";
     std::string output;
     std::string poses = "facefx";
+    std::string phonemes = "common";
+    std::string additionsFor, base;
 };
 }  // namespace
 
@@ -64,10 +66,23 @@ void addCurvesCommand(CLI::App& app) {
     gen->add_option("--rules", o->rules, "Rules file (TOML)")->capture_default_str();
     gen->add_option("-o,--output", o->output, "Curve set to write (JSON)")->required();
     gen->add_option("--poses", o->poses, "Pose set")->capture_default_str();
+    gen->add_option("--phonemes", o->phonemes, "Phoneme set (common, mandarin, or a file)")->capture_default_str();
+    gen->add_option("--additions-for", o->additionsFor,
+                    "Write only the bigrams with this class, as a character file on --base "
+                    "(a language's additions)");
+    gen->add_option("--base", o->base, "The curve set the additions extend");
     gen->callback([o] {
         const auto poses = lipsync::PoseSet::named(o->poses);
-        const auto set = lipsync::generateCurveSet(findDataFile(o->rules), poses);
-        set.save(o->output, poses, PhonemeSet::common());
+        const auto& phonemes = PhonemeSet::named(o->phonemes);
+        const auto set = lipsync::generateCurveSet(findDataFile(o->rules), poses, phonemes);
+        if (!o->additionsFor.empty()) {
+            const auto cls = phonemes.find(o->additionsFor);
+            if (!cls) throw CLI::ValidationError("--additions-for", "'" + o->additionsFor + "' is not a class of " + o->phonemes);
+            if (o->base.empty()) throw CLI::ValidationError("--base", "needed with --additions-for");
+            set.saveAdditions(o->output, o->base, *cls, poses, phonemes);
+        } else {
+            set.save(o->output, poses, phonemes);
+        }
         std::cerr << "lipsync curves: wrote " << o->output << '\n';
     });
 }

@@ -27,24 +27,26 @@ std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>
     return items;
 }
 
-PhonemeSchedule readLabels(const fs::path& file, const std::string& alphabet) {
+PhonemeSchedule readLabels(const fs::path& file, const std::string& alphabet, const PhonemeSet* set) {
     std::vector<std::string> warnings;
     PhonemeSchedule labels;
     if (alphabet == "auto") {
         ScheduleReadOptions strict;
         strict.unknownIsError = true;
+        strict.set = set;
         try {
             return readScheduleFile(file, strict);
         } catch (const InputError&) {
-            // Not all common-set names: ARPAbet is the other alphabet labels come in.
+            // Not all class names: ARPAbet is the other alphabet labels come in.
         }
-        return readLabels(file, "arpabet");
+        return readLabels(file, "arpabet", set);
     }
+    ScheduleReadOptions options;
+    options.set = set;
     if (alphabet == "common") {
-        labels = readScheduleFile(file, {}, &warnings);
+        labels = readScheduleFile(file, options, &warnings);
     } else {
         const auto map = PhonemeMap::named(alphabet);
-        ScheduleReadOptions options;
         options.map = &map;
         labels = readScheduleFile(file, options, &warnings);
     }

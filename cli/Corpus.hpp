@@ -22,6 +22,8 @@ std::vector<CorpusItem> listCorpus(const std::filesystem::path& dir,
 
 // Reads labels in `alphabet`: "common", "arpabet", a map name or file, or "auto" (common-set
 // names if every symbol is one, else ARPAbet).
-PhonemeSchedule readLabels(const std::filesystem::path& file, const std::string& alphabet);
+// `set`: the classes the schedule is in (default: the common set).
+PhonemeSchedule readLabels(const std::filesystem::path& file, const std::string& alphabet,
+                           const PhonemeSet* set = nullptr);
 
 }  // namespace lipsyncd::cli

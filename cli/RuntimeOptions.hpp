@@ -19,6 +19,7 @@ struct RuntimeOptions {
     std::string curves = "english";
     std::string character;
     std::string runtime = "bigram";
+    std::string phonemes = "common";
     lipsync::RuntimeConfig config;
 
     // `withWeights`: add --weights (commands whose main output is something else).
@@ -33,6 +34,9 @@ struct RuntimeOptions {
                        "filter (paper 001, section 5), simpler and lower-latency")
             ->check(CLI::IsMember({"bigram", "filter"}))
             ->capture_default_str();
+        cmd.add_option("--phonemes", phonemes,
+                       "Phoneme set of the schedule and curves: common, mandarin (common + ü), or a file")
+            ->capture_default_str();
         cmd.add_option("--character", character,
                        "Character file: a base curve set with some bigrams replaced");
         cmd.add_option("--weights-rate", config.outputRate, "Pose-weight frames per second")
@@ -46,17 +50,19 @@ struct RuntimeOptions {
         lipsync::PoseSet poses;
         lipsync::BigramCurveSet curves;
     };
+    const PhonemeSet& phonemeSet() const { return PhonemeSet::named(phonemes); }
+
     Loaded load() const {
         auto poseSet = lipsync::PoseSet::named(poses);
-        auto set = character.empty() ? lipsync::BigramCurveSet::named(curves, poseSet)
-                                     : lipsync::BigramCurveSet::load(findDataFile(character), poseSet);
+        auto set = character.empty() ? lipsync::BigramCurveSet::named(curves, poseSet, phonemeSet())
+                                     : lipsync::BigramCurveSet::load(findDataFile(character), poseSet, phonemeSet());
         return {std::move(poseSet), std::move(set)};
     }
 
     PoseTrack animate(const PhonemeSchedule& schedule) const {
         const auto loaded = load();
-        if (runtime == "filter") return lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config);
-        return lipsync::animate(schedule, loaded.curves, loaded.poses, config);
+        if (runtime == "filter") return lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config, phonemeSet());
+        return lipsync::animate(schedule, loaded.curves, loaded.poses, config, phonemeSet());
     }
 
     void writeWeights(const PoseTrack& track) const {

@@ -8,11 +8,11 @@ namespace lipsyncd {
 
 namespace {
 // Reads a symbol -> class table, checking every target is a class of the common set.
-std::unordered_map<std::string, std::string> readTable(const TomlTable& doc, const char* key) {
+std::unordered_map<std::string, std::string> readTable(const TomlTable& doc, const char* key,
+                                                       const PhonemeSet& set) {
     std::unordered_map<std::string, std::string> out;
     const auto table = doc.optTable(key);
     if (!table) return out;
-    const PhonemeSet& set = PhonemeSet::common();
     for (const auto& symbol : table->keys()) {
         std::string target = table->getString(symbol);
         if (!set.find(target))
@@ -32,9 +32,11 @@ PhonemeMap PhonemeMap::load(const std::filesystem::path& file) {
     m.caseSensitive_ = doc.optBool("case_sensitive").value_or(true);
     m.stripStressDigits_ = doc.optBool("strip_stress_digits").value_or(false);
     m.ignored_ = doc.optStringArray("ignore").value_or(std::vector<std::string>{});
+    m.phonemeSet_ = doc.optString("phoneme_set").value_or("common");
+    const PhonemeSet& set = PhonemeSet::named(m.phonemeSet_);
     // Keys are stored normalised so lookups can normalise the symbol the same way.
-    for (auto& [k, v] : readTable(doc, "map")) m.exact_.emplace(m.normalise(k), v);
-    for (auto& [k, v] : readTable(doc, "nearest")) m.nearest_.emplace(m.normalise(k), v);
+    for (auto& [k, v] : readTable(doc, "map", set)) m.exact_.emplace(m.normalise(k), v);
+    for (auto& [k, v] : readTable(doc, "nearest", set)) m.nearest_.emplace(m.normalise(k), v);
     for (auto& s : m.ignored_) s = m.normalise(s);
     doc.finish();
     if (m.exact_.empty()) throw InputError(file.string(), 0, "phoneme map has an empty [map]");

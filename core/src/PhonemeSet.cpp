@@ -1,4 +1,8 @@
 #include <lipsyncd/core.hpp>
+
+#include <map>
+#include <memory>
+#include <mutex>
 #include <lipsyncd/toml_table.hpp>
 
 #include <algorithm>
@@ -21,6 +25,10 @@ PhonemeSet::PhonemeSet(std::vector<PhonemeClass> classes) : classes_(std::move(c
 PhonemeSet PhonemeSet::load(const std::filesystem::path& file) {
     const auto doc = TomlTable::parseFile(file);
     std::vector<PhonemeClass> classes;
+    if (const auto base = doc.optString("extends")) {
+        const auto& b = named(*base);
+        classes.assign(b.classes().begin(), b.classes().end());
+    }
     doc.optInteger("version");
     doc.optString("description");
     for (const auto& entry : doc.tableArray("class")) {
@@ -36,6 +44,23 @@ PhonemeSet PhonemeSet::load(const std::filesystem::path& file) {
     } catch (const InputError& e) {
         throw InputError(file.string(), 0, e.what());
     }
+}
+
+const PhonemeSet& PhonemeSet::named(const std::string& nameOrPath) {
+    if (nameOrPath == "common") return common();
+    // Sets are small and few; each is loaded once and lives as long as the process.
+    static std::mutex mutex;
+    static std::map<std::string, std::unique_ptr<PhonemeSet>> loaded;
+    std::lock_guard lock(mutex);
+    auto& slot = loaded[nameOrPath];
+    if (!slot) {
+        const std::filesystem::path p(nameOrPath);
+        const auto file = p.has_extension() || p.has_parent_path()
+                              ? findDataFile(p)
+                              : findDataFile(std::filesystem::path("phonemes") / (nameOrPath + ".toml"));
+        slot = std::make_unique<PhonemeSet>(load(file));
+    }
+    return *slot;
 }
 
 const PhonemeSet& PhonemeSet::common() {

@@ -62,7 +62,7 @@ std::vector<ControlPoint> readPolygon(const json& points, const std::filesystem:
 
 // Reads {"a-b": {"pose": [[t, v], ...]}} into `set`; returns how many bigrams it read.
 std::size_t readBigrams(const json& bigrams, const std::filesystem::path& file, const PoseSet& poses,
-                        const PhonemeSet& phonemes, BigramCurveSet& set, std::vector<bool>* seen) {
+                        const PhonemeSet& phonemes, BigramCurveSet& set) {
     if (!bigrams.is_object()) fail(file, "bigrams", "expected an object of \"a-b\": {pose: points}");
     for (const auto& [key, curves] : bigrams.items()) {
         const auto where = "bigrams." + key;
@@ -77,7 +77,6 @@ std::size_t readBigrams(const json& bigrams, const std::filesystem::path& file, 
             if (!idx) fail(file, where + "." + pose, "unknown pose (pose set '" + poses.name() + "')");
             set.setCurve(*first, *second, *idx, ControlCurve(readPolygon(points, file, where + "." + pose)));
         }
-        if (seen) (*seen)[*first * phonemes.size() + *second] = true;
     }
     return bigrams.size();
 }
@@ -98,7 +97,7 @@ std::filesystem::path resolveBase(const std::string& base, const std::filesystem
 
 BigramCurveSet::BigramCurveSet(std::string name, const PoseSet& poses, const PhonemeSet& phonemes)
     : name_(std::move(name)), classes_(phonemes.size()), poses_(poses.size()),
-      curves_(classes_ * classes_ * poses_) {}
+      curves_(classes_ * classes_ * poses_), defined_(classes_ * classes_, false) {}
 
 const ControlCurve* BigramCurveSet::curve(std::size_t first, std::size_t second, std::size_t pose) const {
     const auto& c = curves_[slot(first, second, pose)];
@@ -106,6 +105,7 @@ const ControlCurve* BigramCurveSet::curve(std::size_t first, std::size_t second,
 }
 
 void BigramCurveSet::setCurve(std::size_t first, std::size_t second, std::size_t pose, ControlCurve curve) {
+    defined_[first * classes_ + second] = true;
     const auto p = curve.polygon();
     const bool zero = std::all_of(p.begin(), p.end(), [](const ControlPoint& c) { return c.value == 0; });
     auto& slotRef = curves_[slot(first, second, pose)];
@@ -117,26 +117,37 @@ void BigramCurveSet::setCurve(std::size_t first, std::size_t second, std::size_t
 
 BigramCurveSet BigramCurveSet::load(const std::filesystem::path& file, const PoseSet& poses,
                                     const PhonemeSet& phonemes) {
+    return loadSet(file, poses, phonemes, true);
+}
+
+// A character's base may cover fewer classes than `phonemes` (a language adding one, as paper
+// 000 section 4.4 does for Mandarin): every pair is required once the overrides are in.
+BigramCurveSet BigramCurveSet::loadSet(const std::filesystem::path& file, const PoseSet& poses,
+                                       const PhonemeSet& phonemes, bool requireEveryPair) {
     const auto j = readJson(file);
     if (j.is_object() && j.value("format", "") == kCharacterFormat) {
         checkHeader(j, file, kCharacterFormat);
         if (!j.contains("base") || !j["base"].is_string()) fail(file, "base", "missing (the curve set it starts from)");
-        auto set = load(resolveBase(j["base"], file), poses, phonemes);
+        auto set = loadSet(resolveBase(j["base"], file), poses, phonemes, false);
         set.applyOverrides(file, poses, phonemes);
+        if (requireEveryPair) set.requireEveryPair(file, phonemes);
         return set;
     }
     checkHeader(j, file, kCurvesFormat);
     checkPoseSet(j, file, poses);
     BigramCurveSet set(j["name"], poses, phonemes);
     if (j.contains("description") && j["description"].is_string()) set.description_ = j["description"];
-    std::vector<bool> seen(phonemes.size() * phonemes.size(), false);
-    readBigrams(j.value("bigrams", json::object()), file, poses, phonemes, set, &seen);
+    readBigrams(j.value("bigrams", json::object()), file, poses, phonemes, set);
+    if (requireEveryPair) set.requireEveryPair(file, phonemes);
+    return set;
+}
+
+void BigramCurveSet::requireEveryPair(const std::filesystem::path& file, const PhonemeSet& phonemes) const {
     for (std::size_t a = 0; a < phonemes.size(); ++a)
         for (std::size_t b = 0; b < phonemes.size(); ++b)
-            if (!seen[a * phonemes.size() + b])
+            if (!defined_[a * classes_ + b])
                 fail(file, "bigrams", "missing pair '" + phonemes[a].name + "-" + phonemes[b].name +
                                           "' (a set covers every pair; list it with {} if no pose moves)");
-    return set;
 }
 
 void BigramCurveSet::applyOverrides(const std::filesystem::path& characterFile, const PoseSet& poses,
@@ -144,7 +155,7 @@ void BigramCurveSet::applyOverrides(const std::filesystem::path& characterFile, 
     const auto j = readJson(characterFile);
     checkHeader(j, characterFile, kCharacterFormat);
     checkPoseSet(j, characterFile, poses);
-    readBigrams(j.value("bigrams", json::object()), characterFile, poses, phonemes, *this, nullptr);
+    readBigrams(j.value("bigrams", json::object()), characterFile, poses, phonemes, *this);
     name_ = j["name"];
 }
 
@@ -155,33 +166,66 @@ BigramCurveSet BigramCurveSet::named(const std::string& nameOrPath, const PoseSe
     return load(findDataFile(std::filesystem::path("curves") / (nameOrPath + ".json")), poses, phonemes);
 }
 
-void BigramCurveSet::save(const std::filesystem::path& file, const PoseSet& poseSet,
-                          const PhonemeSet& set) const {
+namespace {
+json bigramsJson(const BigramCurveSet& s, const PoseSet& poseSet, const PhonemeSet& set,
+                 std::optional<std::size_t> onlyWith) {
     json bigrams = json::object();
     auto rounded = [](float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; };
-    for (std::size_t a = 0; a < classes_; ++a)
-        for (std::size_t b = 0; b < classes_; ++b) {
+    for (std::size_t a = 0; a < s.classes(); ++a)
+        for (std::size_t b = 0; b < s.classes(); ++b) {
+            if (onlyWith && a != *onlyWith && b != *onlyWith) continue;
             json curves = json::object();
-            for (std::size_t p = 0; p < poses_; ++p)
-                if (const auto* c = curve(a, b, p)) {
+            for (std::size_t p = 0; p < s.poses(); ++p)
+                if (const auto* c = s.curve(a, b, p)) {
                     json points = json::array();
                     for (const auto& pt : c->polygon()) points.push_back({rounded(pt.time), rounded(pt.value)});
                     curves[poseSet[p].name] = points;
                 }
             bigrams[set[a].name + "-" + set[b].name] = curves;
         }
-    // One bigram a line: a diff shows which pairs an edit or a rule change touched.
+    return bigrams;
+}
+
+// One bigram a line: a diff shows which pairs an edit or a rule change touched.
+void writeSet(const std::filesystem::path& file, const json& header, const json& bigrams) {
     std::ofstream out(file);
     if (!out) throw InputError(file.string() + ": cannot write");
-    out << "{\n \"format\": \"" << kCurvesFormat << "\",\n \"version\": " << kVersion
-        << ",\n \"name\": " << json(name_).dump() << ",\n \"description\": " << json(description_).dump()
-        << ",\n \"pose_set\": " << json(poseSet.name()).dump() << ",\n \"bigrams\": {";
+    out << "{";
     bool first = true;
+    for (const auto& [key, value] : header.items()) {
+        out << (first ? "\n " : ",\n ") << json(key).dump() << ": " << value.dump();
+        first = false;
+    }
+    out << ",\n \"bigrams\": {";
+    first = true;
     for (const auto& [key, curves] : bigrams.items()) {
         out << (first ? "\n  " : ",\n  ") << json(key).dump() << ": " << curves.dump();
         first = false;
     }
     out << "\n }\n}\n";
+}
+}  // namespace
+
+void BigramCurveSet::save(const std::filesystem::path& file, const PoseSet& poseSet, const PhonemeSet& set) const {
+    json header = json::object();
+    header["format"] = kCurvesFormat;
+    header["version"] = kVersion;
+    header["name"] = name_;
+    header["description"] = description_;
+    header["pose_set"] = poseSet.name();
+    writeSet(file, header, bigramsJson(*this, poseSet, set, std::nullopt));
+}
+
+void BigramCurveSet::saveAdditions(const std::filesystem::path& file, const std::string& base, std::size_t onlyWith,
+                                   const PoseSet& poseSet, const PhonemeSet& set) const {
+    json header = json::object();
+    header["format"] = kCharacterFormat;
+    header["version"] = kVersion;
+    header["name"] = name_;
+    header["description"] = description_;
+    header["base"] = base;
+    header["pose_set"] = poseSet.name();
+    writeSet(file, header, bigramsJson(*this, poseSet, set, onlyWith));
 }
 
 }  // namespace lipsyncd::lipsync

@@ -19,7 +19,7 @@ std::size_t classOf(const PhonemeSegment& s, const PhonemeSet& phonemes) {
     const auto idx = phonemes.find(s.phoneme);
     if (!idx)
         throw InputError("schedule: '" + s.phoneme + "' at " + std::to_string(s.start) +
-                         " s is not a phoneme class (map the schedule to the common set first)");
+                         " s is not a class of the phoneme set in use (map the schedule first; --phonemes picks the set)");
     return *idx;
 }
 

@@ -57,6 +57,46 @@ TEST(CurveFiles, RegeneratingTheShippedSetGivesTheCommittedFile) {
     set.save(out, poses, PhonemeSet::common());
     EXPECT_EQ(slurp(out), slurp(findDataFile("curves/english.json")))
         << "config/curves/english.json is stale: run scripts/make-curves.sh";
+    const auto& mandarin = PhonemeSet::named("mandarin");
+    const auto additions = lipsync::generateCurveSet(findDataFile("curves/mandarin-rules.toml"), poses, mandarin);
+    additions.saveAdditions(out, "english", *mandarin.find("yu"), poses, mandarin);
+    EXPECT_EQ(slurp(out), slurp(findDataFile("curves/mandarin.json")))
+        << "config/curves/mandarin.json is stale: run scripts/make-curves.sh";
+}
+
+TEST(CurveFiles, MandarinAddsOneClassWithItsPairsOnTopOfEnglish) {
+    // Paper 000, section 4.4: the common set plus one phoneme, and only that phoneme's pairs new.
+    const auto& mandarin = PhonemeSet::named("mandarin");
+    ASSERT_EQ(mandarin.size(), PhonemeSet::common().size() + 1);
+    const auto yu = *mandarin.find("yu");
+    EXPECT_EQ(mandarin[yu].group, "rounded");
+    const auto poses = lipsync::PoseSet::named("facefx");
+    const auto set = lipsync::BigramCurveSet::named("mandarin", poses, mandarin);
+    const auto english = lipsync::BigramCurveSet::named("english", poses);
+    const auto w = *poses.find("w");
+    ASSERT_NE(set.curve(*mandarin.find("d"), yu, w), nullptr);  // a new pair: ü rounds the lips
+    EXPECT_GT(set.curve(*mandarin.find("d"), yu, w)->at(0.75), 0.7f);
+    const auto* mine = set.curve(cls("ow"), cls("bmp"), *poses.find("pbm"));  // an English pair, reused
+    const auto* theirs = english.curve(cls("ow"), cls("bmp"), *poses.find("pbm"));
+    ASSERT_TRUE(mine && theirs);
+    EXPECT_TRUE(std::equal(mine->polygon().begin(), mine->polygon().end(), theirs->polygon().begin(), theirs->polygon().end()));
+    // The additions file holds exactly the 2·23 − 1 = 45 pairs that involve ü.
+    const auto text = slurp(findDataFile("curves/mandarin.json"));
+    std::size_t pairs = 0;
+    for (auto at = text.find("\n  \""); at != std::string::npos; at = text.find("\n  \"", at + 1)) {
+        const auto key = text.substr(at + 4, text.find('"', at + 4) - at - 4);
+        EXPECT_TRUE(key.rfind("yu-", 0) == 0 || key.ends_with("-yu")) << key;
+        ++pairs;
+    }
+    EXPECT_EQ(pairs, 45u);
+    // And pinyin maps onto it: ü and its finals to the new class, the rest to the common ones.
+    const auto pinyin = PhonemeMap::named("pinyin");
+    EXPECT_EQ(pinyin.phonemeSet(), "mandarin");
+    EXPECT_EQ(pinyin.map("ü3")->phoneme, "yu");
+    EXPECT_EQ(pinyin.map("ue")->phoneme, "yu");    // xue = x + ue
+    EXPECT_EQ(pinyin.map("ang4")->phoneme, "aa");  // tones stripped
+    EXPECT_EQ(pinyin.map("zh")->phoneme, "sh");
+    EXPECT_FALSE(pinyin.map("qq").has_value());
 }
 
 TEST(CurveFiles, ErrorsNameTheBigramAndPose) {

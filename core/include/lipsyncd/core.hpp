@@ -52,7 +52,11 @@ struct PhonemeClass {
 
 class PhonemeSet {
   public:
+    // A set file may say `extends = "common"`: its classes come after the base set's (a
+    // language adds the phonemes the common set lacks, as paper 000, section 4.4 adds one).
     static PhonemeSet load(const std::filesystem::path& file);
+    // "common", "mandarin" (config/phonemes/NAME.toml) or a path; loaded once per name.
+    static const PhonemeSet& named(const std::string& nameOrPath);
     // The shipped Common Phoneme Set (config/phonemes/common.toml).
     static const PhonemeSet& common();
 
@@ -89,10 +93,13 @@ class PhonemeMap {
     // Marks that are not sounds at all (stress, syllable breaks): callers skip them silently.
     bool isIgnored(std::string_view symbol) const;
     const std::string& name() const { return name_; }
+    // The phoneme set the map's targets belong to (its `phoneme_set` key; "common" if absent).
+    const std::string& phonemeSet() const { return phonemeSet_; }
 
   private:
     std::string normalise(std::string_view symbol) const;
     std::string name_;
+    std::string phonemeSet_ = "common";
     bool caseSensitive_ = true;
     bool stripStressDigits_ = false;
     std::unordered_map<std::string, std::string> exact_;

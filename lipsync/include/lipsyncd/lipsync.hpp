@@ -112,14 +112,22 @@ public:
     std::size_t poses() const { return poses_; }
     // Writes the set (format "lipsyncd-curves", version 1), deterministically.
     void save(const std::filesystem::path& file, const PoseSet& poseSet, const PhonemeSet& set) const;
+    // Writes only the bigrams that involve class `onlyWith`, as a character file on `base`
+    // (a language's additions to a set: paper 000, section 4.4).
+    void saveAdditions(const std::filesystem::path& file, const std::string& base, std::size_t onlyWith,
+                       const PoseSet& poseSet, const PhonemeSet& set) const;
 
 private:
+    static BigramCurveSet loadSet(const std::filesystem::path& file, const PoseSet& poses,
+                                  const PhonemeSet& phonemes, bool requireEveryPair);
+    void requireEveryPair(const std::filesystem::path& file, const PhonemeSet& phonemes) const;
     std::size_t slot(std::size_t first, std::size_t second, std::size_t pose) const {
         return (first * classes_ + second) * poses_ + pose;
     }
     std::string name_, description_;
     std::size_t classes_ = 0, poses_ = 0;
     std::vector<std::optional<ControlCurve>> curves_;
+    std::vector<bool> defined_;  // per bigram: listed in a file (or set by the generator)
 };
 
 // The shipped English set: per-class target poses and coarticulation rules, from a rules file
