@@ -3,14 +3,13 @@
 // the cost of one actuator step for a puppet.
 //
 //   build/bench/output_bench
-#include <lipsyncd/output.hpp>
-
 #include <benchmark/benchmark.h>
+#include <time.h>
 
 #include <algorithm>
 #include <cmath>
+#include <lipsyncd/output.hpp>
 #include <thread>
-#include <time.h>
 
 namespace {
 
@@ -25,11 +24,11 @@ std::int64_t nowNs() {
 using Edges = std::vector<std::pair<std::int64_t, bool>>;
 
 class TimestampLine : public output::GpioLine {
-public:
+  public:
     explicit TimestampLine(Edges& edges) : edges_(&edges) {}
     void set(bool high) override { edges_->emplace_back(nowNs(), high); }
 
-private:
+  private:
     Edges* edges_;
 };
 
@@ -75,7 +74,8 @@ BENCHMARK(ServoPulseJitter)->Iterations(1)->Unit(benchmark::kSecond);
 
 void PuppetStep(benchmark::State& state) {
     const auto puppet = output::Puppet::load(findDataFile("puppets/hid-board.toml"));
-    const std::vector<std::string> poses{"open", "wide", "w", "pbm", "fv", "shch", "tongue_up", "tongue_down", "tongue_back"};
+    const std::vector<std::string> poses{"open", "wide",      "w",           "pbm",        "fv",
+                                         "shch", "tongue_up", "tongue_down", "tongue_back"};
     output::PuppetDriver driver(puppet, poses);
     std::vector<float> w(poses.size(), 0.3f);
     double t = 0;
@@ -84,7 +84,8 @@ void PuppetStep(benchmark::State& state) {
         driver.update(t, w);
         t += 0.01;
     }
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(puppet.actuators.size()));
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) *
+                            static_cast<std::int64_t>(puppet.actuators.size()));
     state.SetLabel("items = actuator commands");
 }
 BENCHMARK(PuppetStep);

@@ -5,10 +5,9 @@
 // which `lipsync analyze` reports, comes on top for the live path).
 //
 //   build/bench/runtime_bench
-#include <lipsyncd/lipsync.hpp>
-
 #include <benchmark/benchmark.h>
 
+#include <lipsyncd/lipsync.hpp>
 #include <random>
 
 namespace {
@@ -42,7 +41,9 @@ PhonemeSchedule schedule(std::size_t n) {
 
 void Offline(benchmark::State& state) {
     const auto s = schedule(1000);
-    for (auto _ : state) benchmark::DoNotOptimize(lipsync::animate(s, shipped().curves, shipped().poses).values.data());
+    for (auto _ : state)
+        benchmark::DoNotOptimize(
+            lipsync::animate(s, shipped().curves, shipped().poses).values.data());
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * 1000);
     state.SetLabel("items = phonemes");
 }
@@ -51,7 +52,8 @@ BENCHMARK(Offline)->Unit(benchmark::kMillisecond);
 void Filter(benchmark::State& state) {
     const auto s = schedule(1000);
     for (auto _ : state)
-        benchmark::DoNotOptimize(lipsync::animateFilter(s, shipped().curves, shipped().poses).values.data());
+        benchmark::DoNotOptimize(
+            lipsync::animateFilter(s, shipped().curves, shipped().poses).values.data());
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * 1000);
 }
 BENCHMARK(Filter)->Unit(benchmark::kMillisecond);

@@ -67,7 +67,8 @@ void addAnalyzeCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "analyze", "Analyse speech audio into a timed phoneme schedule (linear prediction)");
     cmd->add_option("input", o->input, "Audio file (WAV, FLAC, OGG; '-' for stdin)")->required();
-    auto* schedule = cmd->add_option("--schedule,-s", o->schedule, "Write the schedule here ('-' for stdout)");
+    auto* schedule =
+        cmd->add_option("--schedule,-s", o->schedule, "Write the schedule here ('-' for stdout)");
     cmd->add_option("--format", o->format, "Schedule format")
         ->check(CLI::IsMember({"tsv", "json"}))
         ->capture_default_str();
@@ -78,7 +79,8 @@ void addAnalyzeCommand(CLI::App& app) {
     o->runtime.addTo(*cmd, true);
     cmd->callback([o, schedule] {
         if (o->schedule.empty() && o->runtime.weights.empty())
-            throw CLI::ValidationError(schedule->get_name(), "nothing to write: give --schedule and/or --weights");
+            throw CLI::ValidationError(schedule->get_name(),
+                                       "nothing to write: give --schedule and/or --weights");
         runAnalyze(*o);
     });
 }

@@ -1,10 +1,10 @@
 // lipsync animate: a phoneme schedule to mouth-pose weights (the phone-bigram runtime), and
 // lipsync curves generate: the curve set from its rules.
+#include <iostream>
+
 #include "Commands.hpp"
 #include "Corpus.hpp"
 #include "RuntimeOptions.hpp"
-
-#include <iostream>
 
 namespace lipsyncd::cli {
 
@@ -26,7 +26,8 @@ void runAnimate(const AnimateOptions& o) {
     }
     // Streaming, as the daemon runs it: segment by segment, with the given delay.
     const auto loaded = o.runtime.load();
-    lipsync::StreamingRuntime stream(loaded.curves, loaded.poses, o.delay, o.runtime.config, o.runtime.phonemeSet());
+    lipsync::StreamingRuntime stream(loaded.curves, loaded.poses, o.delay, o.runtime.config,
+                                     o.runtime.phonemeSet());
     PoseTrack track;
     for (const auto& s : schedule) stream.push(s, track);
     stream.finish(track);
@@ -46,8 +47,10 @@ void addAnimateCommand(CLI::App& app) {
     auto o = std::make_shared<AnimateOptions>();
     auto* cmd = app.add_subcommand(
         "animate", "Turn a phoneme schedule into mouth-pose weights (phone-bigram runtime)");
-    cmd->add_option("--schedule", o->schedule, "Schedule or labels (TSV/.lab; '-' for stdin)")->required();
-    cmd->add_option("--weights", o->runtime.weights, "Pose weights to write (CSV; '-' for stdout)")->required();
+    cmd->add_option("--schedule", o->schedule, "Schedule or labels (TSV/.lab; '-' for stdin)")
+        ->required();
+    cmd->add_option("--weights", o->runtime.weights, "Pose weights to write (CSV; '-' for stdout)")
+        ->required();
     cmd->add_option("--labels", o->labels,
                     "Schedule alphabet: auto, common, arpabet, ipa, espeak-en, or a map file")
         ->capture_default_str();
@@ -66,7 +69,8 @@ void addCurvesCommand(CLI::App& app) {
     gen->add_option("--rules", o->rules, "Rules file (TOML)")->capture_default_str();
     gen->add_option("-o,--output", o->output, "Curve set to write (JSON)")->required();
     gen->add_option("--poses", o->poses, "Pose set")->capture_default_str();
-    gen->add_option("--phonemes", o->phonemes, "Phoneme set (common, mandarin, or a file)")->capture_default_str();
+    gen->add_option("--phonemes", o->phonemes, "Phoneme set (common, mandarin, or a file)")
+        ->capture_default_str();
     gen->add_option("--additions-for", o->additionsFor,
                     "Write only the bigrams with this class, as a character file on --base "
                     "(a language's additions)");
@@ -77,8 +81,12 @@ void addCurvesCommand(CLI::App& app) {
         const auto set = lipsync::generateCurveSet(findDataFile(o->rules), poses, phonemes);
         if (!o->additionsFor.empty()) {
             const auto cls = phonemes.find(o->additionsFor);
-            if (!cls) throw CLI::ValidationError("--additions-for", "'" + o->additionsFor + "' is not a class of " + o->phonemes);
-            if (o->base.empty()) throw CLI::ValidationError("--base", "needed with --additions-for");
+            if (!cls)
+                throw CLI::ValidationError(
+                    "--additions-for",
+                    "'" + o->additionsFor + "' is not a class of " + o->phonemes);
+            if (o->base.empty())
+                throw CLI::ValidationError("--base", "needed with --additions-for");
             set.saveAdditions(o->output, o->base, *cls, poses, phonemes);
         } else {
             set.save(o->output, poses, phonemes);

@@ -27,7 +27,8 @@ std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>
     return items;
 }
 
-PhonemeSchedule readLabels(const fs::path& file, const std::string& alphabet, const PhonemeSet* set) {
+PhonemeSchedule readLabels(const fs::path& file, const std::string& alphabet,
+                           const PhonemeSet* set) {
     std::vector<std::string> warnings;
     PhonemeSchedule labels;
     if (alphabet == "auto") {

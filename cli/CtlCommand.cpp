@@ -1,9 +1,4 @@
 // lipsync ctl: the client of lipsyncd's control socket (JSON lines).
-#include "Commands.hpp"
-
-#include <lipsyncd/core.hpp>
-
-#include <nlohmann/json.hpp>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
@@ -11,14 +6,18 @@
 #include <chrono>
 #include <cstring>
 #include <iostream>
+#include <lipsyncd/core.hpp>
+#include <nlohmann/json.hpp>
 #include <thread>
+
+#include "Commands.hpp"
 
 namespace lipsyncd::cli {
 
 namespace {
 // One connection; requests and replies are lines.
 class ControlConnection {
-public:
+  public:
     explicit ControlConnection(const std::string& path) {
         fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
         sockaddr_un addr{};
@@ -27,7 +26,8 @@ public:
         if (fd_ < 0 || ::connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) {
             const std::string why = std::strerror(errno);
             if (fd_ >= 0) ::close(fd_);
-            throw InputError(path + ": cannot connect to lipsyncd (" + why + "); is it running? (--socket)");
+            throw InputError(path + ": cannot connect to lipsyncd (" + why +
+                             "); is it running? (--socket)");
         }
     }
     ~ControlConnection() { ::close(fd_); }
@@ -36,7 +36,8 @@ public:
 
     void send(const nlohmann::json& request) {
         const auto line = request.dump() + "\n";
-        if (::send(fd_, line.data(), line.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(line.size()))
+        if (::send(fd_, line.data(), line.size(), MSG_NOSIGNAL) !=
+            static_cast<ssize_t>(line.size()))
             throw std::runtime_error("control socket: write failed");
     }
     std::string readLine() {
@@ -54,7 +55,7 @@ public:
         }
     }
 
-private:
+  private:
     int fd_ = -1;
     std::string buffer_;
 };
@@ -71,7 +72,8 @@ nlohmann::json requestFrom(const CtlOptions& o) {
     const auto& a = o.args;
     const std::string cmd = a.front();
     auto need = [&](std::size_t n, const char* usage) {
-        if (a.size() != n) throw CLI::ValidationError("ctl", std::string("usage: lipsync ctl ") + usage);
+        if (a.size() != n)
+            throw CLI::ValidationError("ctl", std::string("usage: lipsync ctl ") + usage);
     };
     if (cmd == "play") {
         need(2, "play FILE");
@@ -91,7 +93,8 @@ nlohmann::json requestFrom(const CtlOptions& o) {
         need(2, "live on|off");
         return {{"cmd", "live"}, {"on", a[1] == "on"}};
     }
-    if (cmd == "stop" || cmd == "status" || cmd == "queue" || cmd == "reload" || cmd == "subscribe") {
+    if (cmd == "stop" || cmd == "status" || cmd == "queue" || cmd == "reload" ||
+        cmd == "subscribe") {
         need(1, cmd.c_str());
         return {{"cmd", cmd}};
     }
@@ -99,7 +102,9 @@ nlohmann::json requestFrom(const CtlOptions& o) {
         need(2, "raw '{\"cmd\": ...}'");
         return nlohmann::json::parse(a[1]);
     }
-    throw CLI::ValidationError("ctl", "unknown command '" + cmd + "' (play, say, stop, queue, status, live, reload, subscribe, raw)");
+    throw CLI::ValidationError(
+        "ctl", "unknown command '" + cmd +
+                   "' (play, say, stop, queue, status, live, reload, subscribe, raw)");
 }
 
 void runCtl(const CtlOptions& o) {
@@ -108,7 +113,9 @@ void runCtl(const CtlOptions& o) {
     c.send(request);
     const auto reply = nlohmann::json::parse(c.readLine());
     std::cout << reply.dump() << std::endl;
-    if (!reply.value("ok", false)) throw std::runtime_error("lipsyncd: " + reply.value("error", std::string("request refused")));
+    if (!reply.value("ok", false))
+        throw std::runtime_error("lipsyncd: " +
+                                 reply.value("error", std::string("request refused")));
     if (request["cmd"] == "subscribe")
         for (;;) std::cout << c.readLine() << std::endl;  // until interrupted or the daemon goes
     // --wait: until nothing plays or is queued.
@@ -123,8 +130,10 @@ void runCtl(const CtlOptions& o) {
 
 void addCtlCommand(CLI::App& app) {
     auto o = std::make_shared<CtlOptions>();
-    auto* cmd = app.add_subcommand("ctl", "Talk to a running lipsyncd: play FILE, say TEXT, stop, queue, status, "
-                                          "live on|off, reload, subscribe, raw JSON");
+    auto* cmd =
+        app.add_subcommand("ctl",
+                           "Talk to a running lipsyncd: play FILE, say TEXT, stop, queue, status, "
+                           "live on|off, reload, subscribe, raw JSON");
     cmd->add_option("--socket", o->socket, "lipsyncd's control socket")->capture_default_str();
     cmd->add_option("--channel", o->channel, "play: analyse only this channel of the file");
     cmd->add_option("--voice", o->voice, "say: espeak-ng voice");

@@ -1,21 +1,22 @@
 // lipsync drive / check / devices: pose weights through a puppet's actuators; a puppet file
 // validated and explained; the GPIO chips and HID boards present.
-#include "Commands.hpp"
-
-#include <lipsyncd/output.hpp>
-
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <fstream>
 #include <iostream>
+#include <lipsyncd/output.hpp>
 #include <thread>
+
+#include "Commands.hpp"
 
 namespace lipsyncd::cli {
 
 namespace {
 volatile std::sig_atomic_t gStop = 0;  // set by SIGINT/SIGTERM: the one global a signal needs
-extern "C" void onStopSignal(int) { gStop = 1; }
+extern "C" void onStopSignal(int) {
+    gStop = 1;
+}
 
 std::filesystem::path puppetFile(const std::string& nameOrPath) {
     const std::filesystem::path p(nameOrPath);
@@ -28,7 +29,9 @@ struct DriveOptions {
     bool realtime = false, terminal = false, noHardware = false;
 };
 
-void say(const std::string& what) { std::cerr << "lipsync drive: " << what << '\n'; }
+void say(const std::string& what) {
+    std::cerr << "lipsync drive: " << what << '\n';
+}
 
 void runDrive(const DriveOptions& o) {
     const auto puppet = output::Puppet::load(puppetFile(o.puppet));
@@ -45,7 +48,8 @@ void runDrive(const DriveOptions& o) {
             out = &recordFile;
         }
         driver.addSink(std::make_unique<output::RecorderSink>(
-            *out, puppet, json ? output::RecorderSink::Format::JsonLines : output::RecorderSink::Format::Csv));
+            *out, puppet,
+            json ? output::RecorderSink::Format::JsonLines : output::RecorderSink::Format::Csv));
     }
     if (o.terminal) driver.addSink(std::make_unique<output::TerminalSink>(std::cerr, puppet));
 
@@ -62,7 +66,8 @@ void runDrive(const DriveOptions& o) {
         for (double gap = t + 0.01; f > 0 && gap < track.times[f] - 0.01 && !gStop; gap += 0.01) {
             waitUntil(gap);
             driver.tick(gap);
-            if (!stalled && gap - t > puppet.stallTimeout) say("no weights for " + std::to_string(puppet.stallTimeout) + " s: moving to rest");
+            if (!stalled && gap - t > puppet.stallTimeout)
+                say("no weights for " + std::to_string(puppet.stallTimeout) + " s: moving to rest");
             stalled = gap - t > puppet.stallTimeout;
         }
         t = track.times[f];
@@ -82,17 +87,23 @@ void addDriveCommands(CLI::App& app) {
     auto o = std::make_shared<DriveOptions>();
     auto* drive = app.add_subcommand("drive", "Play pose weights through a puppet's actuators");
     drive->add_option("--weights", o->weights, "Pose weights (CSV; '-' for stdin)")->required();
-    drive->add_option("--puppet", o->puppet, "Puppet file (or a name in config/puppets: jaw-servo, terminal, ...)")
+    drive
+        ->add_option("--puppet", o->puppet,
+                     "Puppet file (or a name in config/puppets: jaw-servo, terminal, ...)")
         ->required();
-    drive->add_flag("--realtime", o->realtime, "Play at the weights' own pace (default: as fast as possible)");
-    drive->add_option("--record", o->record, "Record every command (CSV, or JSON lines for .jsonl; '-' for stdout)");
+    drive->add_flag("--realtime", o->realtime,
+                    "Play at the weights' own pace (default: as fast as possible)");
+    drive->add_option("--record", o->record,
+                      "Record every command (CSV, or JSON lines for .jsonl; '-' for stdout)");
     drive->add_flag("--terminal", o->terminal, "Show a live bar per actuator on stderr");
-    drive->add_flag("--no-hardware", o->noHardware, "Do not open GPIO or HID outputs (recorder/terminal only)");
+    drive->add_flag("--no-hardware", o->noHardware,
+                    "Do not open GPIO or HID outputs (recorder/terminal only)");
     drive->callback([o] { runDrive(*o); });
 
     auto puppet = std::make_shared<std::string>();
     auto weights = std::make_shared<std::string>();
-    auto* check = app.add_subcommand("check", "Validate a puppet file and print the resolved mapping");
+    auto* check =
+        app.add_subcommand("check", "Validate a puppet file and print the resolved mapping");
     check->add_option("--puppet", *puppet, "Puppet file or name")->required();
     check->add_option("--weights", *weights, "Also check its poses against this weights file");
     check->callback([puppet, weights] {
@@ -101,15 +112,21 @@ void addDriveCommands(CLI::App& app) {
         p.describe(std::cout);
     });
 
-    auto* devices = app.add_subcommand("devices", "List the GPIO chips and USB HID devices present");
+    auto* devices =
+        app.add_subcommand("devices", "List the GPIO chips and USB HID devices present");
     devices->callback([] {
         const auto chips = output::listGpioChips();
         std::cout << "GPIO chips (name them in a puppet as chip = \"gpiochipN\", line = OFFSET):\n";
-        if (chips.empty()) std::cout << "  none (no /dev/gpiochip*, or no permission: add yourself to group gpio)\n";
+        if (chips.empty())
+            std::cout
+                << "  none (no /dev/gpiochip*, or no permission: add yourself to group gpio)\n";
         for (const auto& c : chips) std::cout << "  " << c << '\n';
         const auto hid = output::listHidDevices();
-        std::cout << "USB HID devices (name them in a [[hid]] table as vid = 0xVVVV, pid = 0xPPPP, or path):\n";
-        if (hid.empty()) std::cout << "  none (no /dev/hidraw*, or no permission: see systemd/99-lipsyncd-hidraw.rules)\n";
+        std::cout << "USB HID devices (name them in a [[hid]] table as vid = 0xVVVV, pid = 0xPPPP, "
+                     "or path):\n";
+        if (hid.empty())
+            std::cout << "  none (no /dev/hidraw*, or no permission: see "
+                         "systemd/99-lipsyncd-hidraw.rules)\n";
         for (const auto& h : hid) std::cout << "  " << h << '\n';
     });
 }

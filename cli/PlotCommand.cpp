@@ -1,10 +1,10 @@
 // lipsync plot: pose weights (and the schedule under them) as an SVG chart.
+#include <optional>
+
 #include "Commands.hpp"
 #include "Corpus.hpp"
 #include "Output.hpp"
 #include "PoseTrackSvg.hpp"
-
-#include <optional>
 
 namespace lipsyncd::cli {
 
@@ -14,13 +14,17 @@ void addPlotCommand(CLI::App& app) {
         SvgChartOptions chart;
     };
     auto o = std::make_shared<Options>();
-    auto* cmd = app.add_subcommand("plot", "Draw pose weights over time, phonemes underneath, as SVG");
-    cmd->add_option("--weights", o->weights, "Pose weights (CSV from animate/analyze/say)")->required();
+    auto* cmd =
+        app.add_subcommand("plot", "Draw pose weights over time, phonemes underneath, as SVG");
+    cmd->add_option("--weights", o->weights, "Pose weights (CSV from animate/analyze/say)")
+        ->required();
     cmd->add_option("--schedule", o->schedule, "Phoneme schedule to show under the curves");
-    cmd->add_option("--labels", o->labels, "Schedule alphabet (as for animate)")->capture_default_str();
+    cmd->add_option("--labels", o->labels, "Schedule alphabet (as for animate)")
+        ->capture_default_str();
     cmd->add_option("-o,--output", o->output, "SVG file to write ('-' for stdout)")->required();
     cmd->add_option("--pixels-per-second", o->chart.pixelsPerSecond, "Horizontal scale")
-        ->check(CLI::Range(10.0, 5000.0))->capture_default_str();
+        ->check(CLI::Range(10.0, 5000.0))
+        ->capture_default_str();
     cmd->callback([o] {
         const auto track = readPoseTrackCsvFile(o->weights);
         std::optional<PhonemeSchedule> schedule;

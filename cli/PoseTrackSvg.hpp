@@ -3,9 +3,8 @@
 // under the curves. Written by hand (SVG is text); no plotting library.
 #pragma once
 
-#include <lipsyncd/core.hpp>
-
 #include <iosfwd>
+#include <lipsyncd/core.hpp>
 
 namespace lipsyncd::cli {
 

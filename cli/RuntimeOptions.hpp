@@ -2,14 +2,12 @@
 // character, output rate, the steps to run, and the weights file to write.
 #pragma once
 
-#include "Output.hpp"
-
-#include <lipsyncd/lipsync.hpp>
-
 #include <CLI/CLI.hpp>
-
+#include <lipsyncd/lipsync.hpp>
 #include <memory>
 #include <string>
+
+#include "Output.hpp"
 
 namespace lipsyncd::cli {
 
@@ -25,8 +23,10 @@ struct RuntimeOptions {
     // `withWeights`: add --weights (commands whose main output is something else).
     void addTo(CLI::App& cmd, bool withWeights) {
         if (withWeights)
-            cmd.add_option("--weights", weights, "Write mouth-pose weights here (CSV, '-' for stdout)");
-        cmd.add_option("--poses", poses, "Pose set (config/poses/NAME.toml, or a file)")->capture_default_str();
+            cmd.add_option("--weights", weights,
+                           "Write mouth-pose weights here (CSV, '-' for stdout)");
+        cmd.add_option("--poses", poses, "Pose set (config/poses/NAME.toml, or a file)")
+            ->capture_default_str();
         cmd.add_option("--curves", curves, "Bigram curve set (config/curves/NAME.json, or a file)")
             ->capture_default_str();
         cmd.add_option("--runtime", runtime,
@@ -34,13 +34,15 @@ struct RuntimeOptions {
                        "filter (paper 001, section 5), simpler and lower-latency")
             ->check(CLI::IsMember({"bigram", "filter"}))
             ->capture_default_str();
-        cmd.add_option("--phonemes", phonemes,
-                       "Phoneme set of the schedule and curves: common, mandarin (common + ü), or a file")
+        cmd.add_option(
+               "--phonemes", phonemes,
+               "Phoneme set of the schedule and curves: common, mandarin (common + ü), or a file")
             ->capture_default_str();
         cmd.add_option("--character", character,
                        "Character file: a base curve set with some bigrams replaced");
         cmd.add_option("--weights-rate", config.outputRate, "Pose-weight frames per second")
-            ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
+            ->check(CLI::Range(1.0, 1000.0))
+            ->capture_default_str();
         cmd.add_flag("!--no-smoothing", config.smoothing, "Skip valley smoothing (for comparison)");
         cmd.add_flag("!--no-constraints", config.constraints, "Skip pose-pair constraints");
         cmd.add_flag("!--no-speed-limits", config.speedLimits, "Skip speed limits");
@@ -55,13 +57,16 @@ struct RuntimeOptions {
     Loaded load() const {
         auto poseSet = lipsync::PoseSet::named(poses);
         auto set = character.empty() ? lipsync::BigramCurveSet::named(curves, poseSet, phonemeSet())
-                                     : lipsync::BigramCurveSet::load(findDataFile(character), poseSet, phonemeSet());
+                                     : lipsync::BigramCurveSet::load(findDataFile(character),
+                                                                     poseSet, phonemeSet());
         return {std::move(poseSet), std::move(set)};
     }
 
     PoseTrack animate(const PhonemeSchedule& schedule) const {
         const auto loaded = load();
-        if (runtime == "filter") return lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config, phonemeSet());
+        if (runtime == "filter")
+            return lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config,
+                                          phonemeSet());
         return lipsync::animate(schedule, loaded.curves, loaded.poses, config, phonemeSet());
     }
 

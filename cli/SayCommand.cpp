@@ -1,13 +1,12 @@
 // lipsync say: espeak-ng speaks a line; its own phoneme events give the exact schedule.
-#include "Commands.hpp"
-#include "Output.hpp"
-#include "RuntimeOptions.hpp"
-
+#include <iostream>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/dsp.hpp>
 #include <lipsyncd/tts.hpp>
 
-#include <iostream>
+#include "Commands.hpp"
+#include "Output.hpp"
+#include "RuntimeOptions.hpp"
 
 namespace lipsyncd::cli {
 
@@ -35,9 +34,11 @@ void runSay(const SayOptions& o) {
         for (const auto& w : warnings) std::cerr << "lipsync say: warning: " << w << '\n';
     }
     if (!o.schedule.empty())
-        withOutputStream(o.schedule, [&](std::ostream& out) { writeSchedule(out, schedule, false); });
+        withOutputStream(o.schedule,
+                         [&](std::ostream& out) { writeSchedule(out, schedule, false); });
     if (!o.runtime.weights.empty()) {
-        if (o.raw) throw CLI::ValidationError("--weights", "needs the common set: drop --raw-phonemes");
+        if (o.raw)
+            throw CLI::ValidationError("--weights", "needs the common set: drop --raw-phonemes");
         o.runtime.writeWeights(o.runtime.animate(schedule));
     }
 }
@@ -61,7 +62,8 @@ void addSayCommand(CLI::App& app) {
     o->runtime.addTo(*cmd, true);
     cmd->callback([o] {
         if (o->wav.empty() && o->schedule.empty() && o->runtime.weights.empty())
-            throw CLI::ValidationError("say", "nothing to write: give --wav, --schedule and/or --weights");
+            throw CLI::ValidationError("say",
+                                       "nothing to write: give --wav, --schedule and/or --weights");
         runSay(*o);
     });
 }

@@ -1,8 +1,7 @@
-#include <lipsyncd/core.hpp>
-#include <lipsyncd/toml_table.hpp>
-
 #include <algorithm>
 #include <cctype>
+#include <lipsyncd/core.hpp>
+#include <lipsyncd/toml_table.hpp>
 
 namespace lipsyncd {
 
@@ -46,7 +45,8 @@ PhonemeMap PhonemeMap::load(const std::filesystem::path& file) {
 PhonemeMap PhonemeMap::named(std::string_view nameOrPath) {
     const std::filesystem::path given(nameOrPath);
     if (given.has_extension()) return load(findDataFile(given));
-    return load(findDataFile(std::filesystem::path("phonemes") / (std::string(nameOrPath) + ".toml")));
+    return load(
+        findDataFile(std::filesystem::path("phonemes") / (std::string(nameOrPath) + ".toml")));
 }
 
 std::string PhonemeMap::normalise(std::string_view symbol) const {

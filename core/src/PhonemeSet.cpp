@@ -1,11 +1,9 @@
+#include <algorithm>
 #include <lipsyncd/core.hpp>
-
+#include <lipsyncd/toml_table.hpp>
 #include <map>
 #include <memory>
 #include <mutex>
-#include <lipsyncd/toml_table.hpp>
-
-#include <algorithm>
 
 namespace lipsyncd {
 
@@ -55,9 +53,10 @@ const PhonemeSet& PhonemeSet::named(const std::string& nameOrPath) {
     auto& slot = loaded[nameOrPath];
     if (!slot) {
         const std::filesystem::path p(nameOrPath);
-        const auto file = p.has_extension() || p.has_parent_path()
-                              ? findDataFile(p)
-                              : findDataFile(std::filesystem::path("phonemes") / (nameOrPath + ".toml"));
+        const auto file =
+            p.has_extension() || p.has_parent_path()
+                ? findDataFile(p)
+                : findDataFile(std::filesystem::path("phonemes") / (nameOrPath + ".toml"));
         slot = std::make_unique<PhonemeSet>(load(file));
     }
     return *slot;

@@ -1,20 +1,19 @@
 // Where the sound goes, and the clock the mouth follows: how many samples have been heard.
 // ALSA reports it as written minus snd_pcm_delay (what is still queued before the speaker);
 // the null and file sinks have no device, so a monotonic clock stands in for the speaker.
-#include <lipsyncd/daemon.hpp>
-#include <lipsyncd/dsp.hpp>
-
 #include <alsa/asoundlib.h>
 #include <sndfile.h>
 
 #include <algorithm>
 #include <chrono>
+#include <lipsyncd/daemon.hpp>
+#include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::daemon {
 
 namespace {
 class ClockSink : public AudioSink {
-public:
+  public:
     void open(int rate) override {
         rate_ = rate;
         written_ = 0;
@@ -23,19 +22,24 @@ public:
     std::size_t write(std::span<const float> samples) override {
         // Take no more than half a second ahead of the clock, as a device buffer would.
         const auto room = static_cast<std::int64_t>(elapsed() * rate_ + rate_ / 2) - written_;
-        const auto n = static_cast<std::size_t>(std::clamp<std::int64_t>(room, 0, static_cast<std::int64_t>(samples.size())));
+        const auto n = static_cast<std::size_t>(
+            std::clamp<std::int64_t>(room, 0, static_cast<std::int64_t>(samples.size())));
         consume(samples.first(n));
         written_ += static_cast<std::int64_t>(n);
         return n;
     }
-    std::int64_t played() override { return std::min(written_, static_cast<std::int64_t>(elapsed() * rate_)); }
+    std::int64_t played() override {
+        return std::min(written_, static_cast<std::int64_t>(elapsed() * rate_));
+    }
     void stop() override { written_ = played(); }
 
-protected:
+  protected:
     virtual void consume(std::span<const float>) {}
 
-private:
-    double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  private:
+    double elapsed() const {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    }
     int rate_ = 48000;
     std::int64_t written_ = 0;
     std::chrono::steady_clock::time_point start_;
@@ -43,7 +47,7 @@ private:
 
 // A WAV file receives every sample played (tests compare it with the source).
 class FileSink : public ClockSink {
-public:
+  public:
     explicit FileSink(std::string path) : path_(std::move(path)) {}
     ~FileSink() override { close(); }
     void open(int rate) override {
@@ -53,11 +57,13 @@ public:
         info.channels = 1;
         info.format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
         file_ = sf_open(path_.c_str(), SFM_WRITE, &info);
-        if (!file_) throw InputError("audio file '" + path_ + "': cannot write (" + sf_strerror(nullptr) + ")");
+        if (!file_)
+            throw InputError("audio file '" + path_ + "': cannot write (" + sf_strerror(nullptr) +
+                             ")");
         ClockSink::open(rate);
     }
 
-private:
+  private:
     void consume(std::span<const float> s) override {
         if (file_) sf_write_float(file_, s.data(), static_cast<sf_count_t>(s.size()));
     }
@@ -70,19 +76,21 @@ private:
 };
 
 class AlsaSink : public AudioSink {
-public:
+  public:
     explicit AlsaSink(std::string device) : device_(std::move(device)) {
         // Open once at start so a missing device is an error now, not at the first request.
         if (snd_pcm_open(&pcm_, device_.c_str(), SND_PCM_STREAM_PLAYBACK, SND_PCM_NONBLOCK) < 0)
-            throw InputError("audio device '" + device_ + "': cannot open for playback (no sound card? use device = \"null\")");
+            throw InputError("audio device '" + device_ +
+                             "': cannot open for playback (no sound card? use device = \"null\")");
     }
     ~AlsaSink() override {
         if (pcm_) snd_pcm_close(pcm_);
     }
     void open(int rate) override {
         snd_pcm_drop(pcm_);
-        const int err = snd_pcm_set_params(pcm_, SND_PCM_FORMAT_FLOAT_LE, SND_PCM_ACCESS_RW_INTERLEAVED, 1,
-                                           static_cast<unsigned>(rate), 1, 100'000);  // 100 ms buffer
+        const int err =
+            snd_pcm_set_params(pcm_, SND_PCM_FORMAT_FLOAT_LE, SND_PCM_ACCESS_RW_INTERLEAVED, 1,
+                               static_cast<unsigned>(rate), 1, 100'000);  // 100 ms buffer
         if (err < 0) throw InputError("audio device '" + device_ + "': " + snd_strerror(err));
         written_ = 0;
     }
@@ -108,7 +116,7 @@ public:
         written_ = 0;
     }
 
-private:
+  private:
     std::string device_;
     snd_pcm_t* pcm_ = nullptr;
     std::int64_t written_ = 0;
@@ -127,12 +135,14 @@ namespace lipsyncd::daemon {
 
 namespace {
 class AlsaCapture : public CaptureSource {
-public:
+  public:
     AlsaCapture(const std::string& device, int rate) : rate_(rate) {
         if (snd_pcm_open(&pcm_, device.c_str(), SND_PCM_STREAM_CAPTURE, SND_PCM_NONBLOCK) < 0)
-            throw InputError("capture device '" + device + "': cannot open (no sound card or microphone?)");
-        const int err = snd_pcm_set_params(pcm_, SND_PCM_FORMAT_FLOAT_LE, SND_PCM_ACCESS_RW_INTERLEAVED, 1,
-                                           static_cast<unsigned>(rate), 1, 40'000);
+            throw InputError("capture device '" + device +
+                             "': cannot open (no sound card or microphone?)");
+        const int err =
+            snd_pcm_set_params(pcm_, SND_PCM_FORMAT_FLOAT_LE, SND_PCM_ACCESS_RW_INTERLEAVED, 1,
+                               static_cast<unsigned>(rate), 1, 40'000);
         if (err < 0) {
             snd_pcm_close(pcm_);
             throw InputError("capture device '" + device + "': " + snd_strerror(err));
@@ -151,14 +161,14 @@ public:
         return static_cast<std::size_t>(n);
     }
 
-private:
+  private:
     snd_pcm_t* pcm_ = nullptr;
     int rate_;
 };
 
 // A WAV file that arrives at real-time pace from the moment it is opened, then silence.
 class FileCapture : public CaptureSource {
-public:
+  public:
     FileCapture(const std::string& path, int) {
         const auto audio = dsp::readAudioFile(path);
         samples_ = audio.samples;
@@ -168,14 +178,16 @@ public:
     int rate() const override { return rate_; }
     std::size_t read(std::span<float> out) override {
         const auto due = static_cast<std::size_t>(
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() * rate_);
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() *
+            rate_);
         const std::size_t n = std::min(out.size(), due > given_ ? due - given_ : 0);
-        for (std::size_t i = 0; i < n; ++i) out[i] = given_ + i < samples_.size() ? samples_[given_ + i] : 0.0f;
+        for (std::size_t i = 0; i < n; ++i)
+            out[i] = given_ + i < samples_.size() ? samples_[given_ + i] : 0.0f;
         given_ += n;
         return n;
     }
 
-private:
+  private:
     std::vector<float> samples_;
     int rate_ = 16000;
     std::size_t given_ = 0;

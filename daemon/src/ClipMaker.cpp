@@ -16,23 +16,29 @@ struct ClipMaker::Impl {
     std::vector<std::string> poseNames;
 
     explicit Impl(const DaemonConfig& c)
-        : config(c), poses(lipsync::PoseSet::named(c.poses)),
-          curves(c.character.empty() ? lipsync::BigramCurveSet::named(c.curves, poses)
-                                     : lipsync::BigramCurveSet::load(findDataFile(c.character), poses)),
-          templates(c.templates.empty() ? dsp::TemplateSet::loadDefault() : dsp::TemplateSet::load(findDataFile(c.templates))),
+        : config(c),
+          poses(lipsync::PoseSet::named(c.poses)),
+          curves(c.character.empty()
+                     ? lipsync::BigramCurveSet::named(c.curves, poses)
+                     : lipsync::BigramCurveSet::load(findDataFile(c.character), poses)),
+          templates(c.templates.empty() ? dsp::TemplateSet::loadDefault()
+                                        : dsp::TemplateSet::load(findDataFile(c.templates))),
           poseNames(poses.names()) {}
 
     PoseTrack animate(const PhonemeSchedule& s) const {
         lipsync::RuntimeConfig rc;
         rc.outputRate = config.outputRateHz;
-        return config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc) : lipsync::animate(s, curves, poses, rc);
+        return config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc)
+                                          : lipsync::animate(s, curves, poses, rc);
     }
 };
 
 ClipMaker::ClipMaker(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config)) {}
 ClipMaker::~ClipMaker() = default;
 
-const std::vector<std::string>& ClipMaker::poseNames() const { return impl_->poseNames; }
+const std::vector<std::string>& ClipMaker::poseNames() const {
+    return impl_->poseNames;
+}
 
 Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
     dsp::DecodeOptions decode;
@@ -47,7 +53,8 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
     return clip;
 }
 
-Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice) const {
+Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
+                         const std::string& voice) const {
     const auto v = voice.empty() ? impl_->config.voice : voice;
     const auto speech = synth.synthesize({text, v, 0, -1});
     Clip clip;
@@ -66,10 +73,11 @@ namespace {
 // The front end streaming into the bigram runtime in its causal mode: weights for everything
 // up to the last closed phoneme go out as soon as the phoneme closes.
 class StreamingLive : public ClipMaker::Live {
-public:
+  public:
     StreamingLive(const dsp::TemplateSet& templates, const lipsync::BigramCurveSet& curves,
                   const lipsync::PoseSet& poses, double outputRate, int rate)
-        : analyzer_(templates, PhonemeSet::common(), rate), runtime_(curves, poses, 0, config(outputRate)) {
+        : analyzer_(templates, PhonemeSet::common(), rate),
+          runtime_(curves, poses, 0, config(outputRate)) {
         analyzer_.onSegment([this](const PhonemeSegment& s) { runtime_.push(s, *out_); });
         // The newest frame's class stands for the phoneme still open (the segmenter has not
         // closed it yet): the mouth starts moving without waiting for the phoneme to end.
@@ -85,7 +93,7 @@ public:
     }
     double latencySeconds() const override { return analyzer_.latencySeconds(); }
 
-private:
+  private:
     static lipsync::RuntimeConfig config(double rate) {
         lipsync::RuntimeConfig c;
         c.outputRate = rate;
@@ -100,7 +108,8 @@ private:
 }  // namespace
 
 std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
-    return std::make_unique<StreamingLive>(impl_->templates, impl_->curves, impl_->poses, impl_->config.outputRateHz, rate);
+    return std::make_unique<StreamingLive>(impl_->templates, impl_->curves, impl_->poses,
+                                           impl_->config.outputRateHz, rate);
 }
 
 }  // namespace lipsyncd::daemon

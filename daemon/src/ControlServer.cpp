@@ -15,12 +15,14 @@ namespace lipsyncd::daemon {
 
 namespace {
 constexpr std::size_t kMaxLine = 64 * 1024;
-constexpr std::size_t kMaxBacklog = 1024 * 1024;  // bytes queued to a slow client before it is dropped
+constexpr std::size_t kMaxBacklog =
+    1024 * 1024;  // bytes queued to a slow client before it is dropped
 }  // namespace
 
 ControlServer::ControlServer(const std::filesystem::path& path, unsigned mode) : path_(path) {
     sockaddr_un addr{};
-    if (path.string().size() >= sizeof(addr.sun_path)) throw InputError(path.string() + ": socket path too long");
+    if (path.string().size() >= sizeof(addr.sun_path))
+        throw InputError(path.string() + ": socket path too long");
     std::filesystem::create_directories(path.parent_path());
     fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     if (fd_ < 0) throw std::runtime_error(std::string("control socket: ") + std::strerror(errno));
@@ -43,7 +45,8 @@ ControlServer::~ControlServer() {
 
 void ControlServer::addPollFds(std::vector<pollfd>& fds) const {
     fds.push_back({fd_, POLLIN, 0});
-    for (const auto& c : clients_) fds.push_back({c.fd, static_cast<short>(POLLIN | (c.out.empty() ? 0 : POLLOUT)), 0});
+    for (const auto& c : clients_)
+        fds.push_back({c.fd, static_cast<short>(POLLIN | (c.out.empty() ? 0 : POLLOUT)), 0});
 }
 
 void ControlServer::service(const Handler& handle) {
@@ -54,14 +57,16 @@ void ControlServer::service(const Handler& handle) {
     }
     for (auto& c : clients_) {
         readFrom(c);
-        for (auto nl = c.in.find('\n'); nl != std::string::npos && !c.closed; nl = c.in.find('\n')) {
+        for (auto nl = c.in.find('\n'); nl != std::string::npos && !c.closed;
+             nl = c.in.find('\n')) {
             const std::string line = c.in.substr(0, nl);
             c.in.erase(0, nl + 1);
             if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
             c.out += reply(line, c, handle).dump() + "\n";
         }
         if (c.in.size() > kMaxLine) {
-            c.out += nlohmann::json{{"ok", false}, {"error", "request longer than 64 KiB"}}.dump() + "\n";
+            c.out += nlohmann::json{{"ok", false}, {"error", "request longer than 64 KiB"}}.dump() +
+                     "\n";
             c.in.clear();
         }
         flush(c);
@@ -72,7 +77,8 @@ void ControlServer::service(const Handler& handle) {
     });
 }
 
-nlohmann::json ControlServer::reply(const std::string& line, Client& client, const Handler& handle) {
+nlohmann::json ControlServer::reply(const std::string& line, Client& client,
+                                    const Handler& handle) {
     nlohmann::json request;
     try {
         request = nlohmann::json::parse(line);
@@ -80,7 +86,10 @@ nlohmann::json ControlServer::reply(const std::string& line, Client& client, con
         return {{"ok", false}, {"error", std::string("not JSON: ") + e.what()}};
     }
     if (!request.is_object() || !request.contains("cmd") || !request["cmd"].is_string())
-        return {{"ok", false}, {"error", "expected an object with \"cmd\" (play, say, stop, queue, status, live, reload, subscribe)"}};
+        return {{"ok", false},
+                {"error",
+                 "expected an object with \"cmd\" (play, say, stop, queue, status, live, reload, "
+                 "subscribe)"}};
     if (request["cmd"] == "subscribe") {
         client.subscribed = request.value("on", true);
         return {{"ok", true}, {"subscribed", client.subscribed}};
@@ -126,6 +135,8 @@ void ControlServer::broadcast(const nlohmann::json& event) {
         }
 }
 
-std::size_t ControlServer::clients() const { return clients_.size(); }
+std::size_t ControlServer::clients() const {
+    return clients_.size();
+}
 
 }  // namespace lipsyncd::daemon

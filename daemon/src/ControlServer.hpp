@@ -1,15 +1,15 @@
 // The control socket (internal to the daemon).
 #pragma once
 
-#include <lipsyncd/daemon.hpp>
-
-#include <nlohmann/json.hpp>
 #include <poll.h>
+
+#include <lipsyncd/daemon.hpp>
+#include <nlohmann/json.hpp>
 
 namespace lipsyncd::daemon {
 
 class ControlServer {
-public:
+  public:
     using Handler = std::function<nlohmann::json(const nlohmann::json&)>;
     ControlServer(const std::filesystem::path& path, unsigned mode);
     ~ControlServer();
@@ -17,12 +17,12 @@ public:
     ControlServer& operator=(const ControlServer&) = delete;
 
     void addPollFds(std::vector<pollfd>& fds) const;
-    void service(const Handler& handle);  // accept, read, answer, write: never blocks
+    void service(const Handler& handle);          // accept, read, answer, write: never blocks
     void broadcast(const nlohmann::json& event);  // to subscribers
     std::size_t clients() const;
     const std::filesystem::path& path() const { return path_; }
 
-private:
+  private:
     struct Client {
         int fd;
         std::string in, out;

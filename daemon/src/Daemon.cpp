@@ -2,36 +2,45 @@
 // the signals (signalfd). Every tick feeds the audio device, reads its clock and drives the
 // puppet at that clock plus the lead time; the watchdog is petted from the same tick, so a
 // stalled loop is a missed watchdog and systemd restarts the service.
-#include <lipsyncd/daemon.hpp>
-#include <lipsyncd/output.hpp>
-#include <lipsyncd/tts.hpp>
-
-#include "ControlServer.hpp"
-
-#include <nlohmann/json.hpp>
 #include <sys/signalfd.h>
 #include <sys/timerfd.h>
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <fstream>
 #include <iostream>
+#include <lipsyncd/daemon.hpp>
+#include <lipsyncd/output.hpp>
+#include <lipsyncd/tts.hpp>
+#include <nlohmann/json.hpp>
 #include <thread>
+
+#include "ControlServer.hpp"
 
 namespace lipsyncd::daemon {
 
 namespace {
 using nlohmann::json;
 
-void log(const char* level, const std::string& what) { std::cerr << level << "lipsyncd: " << what << std::endl; }
-void info(const std::string& w) { log(SD_INFO, w); }
-void warn(const std::string& w) { log(SD_WARNING, w); }
-void error(const std::string& w) { log(SD_ERR, w); }
+void log(const char* level, const std::string& what) {
+    std::cerr << level << "lipsyncd: " << what << std::endl;
+}
+void info(const std::string& w) {
+    log(SD_INFO, w);
+}
+void warn(const std::string& w) {
+    log(SD_WARNING, w);
+}
+void error(const std::string& w) {
+    log(SD_ERR, w);
+}
 
-void notify(const std::string& state) { sd_notify(0, state.c_str()); }
+void notify(const std::string& state) {
+    sd_notify(0, state.c_str());
+}
 
 std::filesystem::path puppetFile(const std::string& nameOrPath) {
     const std::filesystem::path p(nameOrPath);
@@ -40,7 +49,8 @@ std::filesystem::path puppetFile(const std::string& nameOrPath) {
 }
 
 double monotonicSeconds() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
 }
 
 // Everything the config decides, rebuilt together on reload.
@@ -57,14 +67,17 @@ struct Setup {
         clips = std::make_unique<ClipMaker>(config);
         puppet = std::make_unique<output::Puppet>(output::Puppet::load(puppetFile(config.puppet)));
         driver = std::make_unique<output::PuppetDriver>(*puppet, clips->poseNames());
-        if (config.hardware) output::addHardwareSinks(*driver, *puppet, [](const std::string& m) { warn(m); });
+        if (config.hardware)
+            output::addHardwareSinks(*driver, *puppet, [](const std::string& m) { warn(m); });
         if (!config.record.empty()) {
             recordFile = std::make_unique<std::ofstream>(config.record);
             if (!*recordFile) throw InputError(config.record + ": cannot write the command record");
-            recorder = std::make_unique<output::RecorderSink>(*recordFile, *puppet, output::RecorderSink::Format::Csv);
+            recorder = std::make_unique<output::RecorderSink>(*recordFile, *puppet,
+                                                              output::RecorderSink::Format::Csv);
             driver->addSink(*recorder);
         }
-        if (config.terminal) driver->addSink(std::make_unique<output::TerminalSink>(std::cerr, *puppet));
+        if (config.terminal)
+            driver->addSink(std::make_unique<output::TerminalSink>(std::cerr, *puppet));
         audio = openAudioSink(config.device);
     }
 };
@@ -83,8 +96,8 @@ struct Daemon::Impl {
     double liveStarted = -1;
     std::deque<Clip> queue;
     std::optional<Clip> current;
-    std::size_t written = 0;       // samples of the current clip handed to the device
-    std::int64_t playedBase = 0;   // device position when the current clip started
+    std::size_t written = 0;      // samples of the current clip handed to the device
+    std::int64_t playedBase = 0;  // device position when the current clip started
     double start = monotonicSeconds();
     double lastEvent = 0, lastWatchdog = 0;
     std::uint64_t watchdogUsec = 0;
@@ -110,7 +123,8 @@ struct Daemon::Impl {
 
     // Seconds of the current clip heard so far, by the device's clock.
     double heard() const {
-        return current ? static_cast<double>(setup->audio->played() - playedBase) / current->rate : 0;
+        return current ? static_cast<double>(setup->audio->played() - playedBase) / current->rate
+                       : 0;
     }
 
     // New live weights since the last tick: the mouth takes the newest (the slew limit smooths).
@@ -142,7 +156,10 @@ struct Daemon::Impl {
             liveStarted = now();
             status("live from " + setup->config.captureDevice);
         }
-        return {{"ok", true}, {"live", true}, {"started", liveStarted}, {"front_end_latency", live->latencySeconds()}};
+        return {{"ok", true},
+                {"live", true},
+                {"started", liveStarted},
+                {"front_end_latency", live->latencySeconds()}};
     }
 
     void tick() {
@@ -150,16 +167,19 @@ struct Daemon::Impl {
         startNext();
         const bool following = tickLive(t);
         if (current) {
-            written += setup->audio->write(std::span<const float>(current->samples).subspan(written));
+            written +=
+                setup->audio->write(std::span<const float>(current->samples).subspan(written));
             // The mouth leads the sound by the puppet's lead time; the user's offset moves it.
             const double at = heard() + setup->config.leadSeconds - setup->config.syncOffsetSeconds;
             const auto& w = current->weights;
             if (w.frames() > 0) {
-                const auto f = static_cast<std::size_t>(std::clamp(std::round(at * setup->config.outputRateHz), 0.0,
-                                                                   static_cast<double>(w.frames() - 1)));
+                const auto f =
+                    static_cast<std::size_t>(std::clamp(std::round(at * setup->config.outputRateHz),
+                                                        0.0, static_cast<double>(w.frames() - 1)));
                 if (!following) setup->driver->update(t, w.frame(f));
             }
-            if (written >= current->samples.size() && heard() >= static_cast<double>(current->samples.size()) / current->rate) {
+            if (written >= current->samples.size() &&
+                heard() >= static_cast<double>(current->samples.size()) / current->rate) {
                 ++clipsPlayed;
                 current.reset();
                 if (queue.empty()) status("idle");
@@ -180,7 +200,8 @@ struct Daemon::Impl {
     json event(double t) const {
         json weights = json::object(), actuators = json::object();
         const auto commands = setup->driver->last();
-        for (std::size_t i = 0; i < commands.size(); ++i) actuators[setup->puppet->actuators[i].name] = commands[i].value;
+        for (std::size_t i = 0; i < commands.size(); ++i)
+            actuators[setup->puppet->actuators[i].name] = commands[i].value;
         if (current && current->weights.frames() > 0) {
             const auto f = std::min(current->weights.frames() - 1,
                                     static_cast<std::size_t>(heard() * setup->config.outputRateHz));
@@ -210,7 +231,8 @@ struct Daemon::Impl {
         try {
             auto fresh = std::make_unique<Setup>(configFile);
             setup->driver->rest(now(), 100, [this](double t) {
-                std::this_thread::sleep_for(std::chrono::duration<double>(std::max(0.0, t - now())));
+                std::this_thread::sleep_for(
+                    std::chrono::duration<double>(std::max(0.0, t - now())));
             });
             queue.clear();
             current.reset();
@@ -228,14 +250,21 @@ struct Daemon::Impl {
         const std::string cmd = r.value("cmd", "");
         try {
             if (cmd == "play") {
-                if (!r.contains("file") || !r["file"].is_string()) return {{"ok", false}, {"error", "play needs \"file\""}};
-                queue.push_back(setup->clips->fromFile(r["file"].get<std::string>(), r.value("channel", -1)));
-                return {{"ok", true}, {"queued", queue.back().name}, {"duration", static_cast<double>(queue.back().samples.size()) / queue.back().rate}};
+                if (!r.contains("file") || !r["file"].is_string())
+                    return {{"ok", false}, {"error", "play needs \"file\""}};
+                queue.push_back(
+                    setup->clips->fromFile(r["file"].get<std::string>(), r.value("channel", -1)));
+                return {{"ok", true},
+                        {"queued", queue.back().name},
+                        {"duration",
+                         static_cast<double>(queue.back().samples.size()) / queue.back().rate}};
             }
             if (cmd == "say") {
-                if (!r.contains("text") || !r["text"].is_string()) return {{"ok", false}, {"error", "say needs \"text\""}};
+                if (!r.contains("text") || !r["text"].is_string())
+                    return {{"ok", false}, {"error", "say needs \"text\""}};
                 if (!synth) synth = std::make_unique<EspeakSynthesizer>();
-                queue.push_back(setup->clips->fromText(*synth, r["text"].get<std::string>(), r.value("voice", std::string())));
+                queue.push_back(setup->clips->fromText(*synth, r["text"].get<std::string>(),
+                                                       r.value("voice", std::string())));
                 return {{"ok", true}, {"queued", queue.back().name}};
             }
             if (cmd == "stop") {
@@ -255,7 +284,9 @@ struct Daemon::Impl {
                 quit = true;
                 return {{"ok", true}};
             }
-            return {{"ok", false}, {"error", "unknown cmd '" + cmd + "' (play, say, stop, queue, status, live, reload, subscribe)"}};
+            return {{"ok", false},
+                    {"error", "unknown cmd '" + cmd +
+                                  "' (play, say, stop, queue, status, live, reload, subscribe)"}};
         } catch (const std::exception& e) {
             return {{"ok", false}, {"error", e.what()}};
         }
@@ -265,13 +296,16 @@ struct Daemon::Impl {
 Daemon::Daemon(std::filesystem::path configFile) : impl_(std::make_unique<Impl>()) {
     impl_->configFile = std::move(configFile);
     impl_->setup = std::make_unique<Setup>(impl_->configFile);
-    impl_->control = std::make_unique<ControlServer>(impl_->setup->config.socket, impl_->setup->config.socketMode);
+    impl_->control = std::make_unique<ControlServer>(impl_->setup->config.socket,
+                                                     impl_->setup->config.socketMode);
     sd_watchdog_enabled(0, &impl_->watchdogUsec);
 }
 
 Daemon::~Daemon() = default;
 
-json Daemon::handle(const json& request) { return impl_->handle(request); }
+json Daemon::handle(const json& request) {
+    return impl_->handle(request);
+}
 
 int Daemon::run() {
     auto& d = *impl_;
@@ -285,8 +319,8 @@ int Daemon::run() {
     timerfd_settime(timer, 0, &every10ms, nullptr);
 
     notify("READY=1");
-    d.status("ready: puppet '" + d.setup->puppet->name + "', audio '" + d.setup->config.device + "', control " +
-             d.control->path().string());
+    d.status("ready: puppet '" + d.setup->puppet->name + "', audio '" + d.setup->config.device +
+             "', control " + d.control->path().string());
     int exitSignal = 0;
     while (!exitSignal && !d.quit) {
         std::vector<pollfd> fds{{sigfd, POLLIN, 0}, {timer, POLLIN, 0}};
@@ -304,7 +338,8 @@ int Daemon::run() {
         d.control->service([&](const json& r) { return d.handle(r); });
     }
     notify("STOPPING=1");
-    d.status(std::string("stopping (") + (exitSignal ? strsignal(exitSignal) : "asked") + "): mouth to rest");
+    d.status(std::string("stopping (") + (exitSignal ? strsignal(exitSignal) : "asked") +
+             "): mouth to rest");
     if (d.current) d.setup->audio->stop();
     d.setup->driver->rest(d.now(), 100, [&](double t) {
         std::this_thread::sleep_for(std::chrono::duration<double>(std::max(0.0, t - d.now())));

@@ -7,7 +7,8 @@ namespace lipsyncd::daemon {
 namespace {
 double seconds(const TomlTable& t, const std::string& key, double fallback, double lo, double hi) {
     const double v = t.optNumber(key).value_or(fallback);
-    if (!(v >= lo && v <= hi)) t.fail(key, "must be within " + std::to_string(lo) + " .. " + std::to_string(hi) + " s");
+    if (!(v >= lo && v <= hi))
+        t.fail(key, "must be within " + std::to_string(lo) + " .. " + std::to_string(hi) + " s");
     return v;
 }
 }  // namespace
@@ -26,7 +27,8 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         c.curves = mouth->optString("curves").value_or(c.curves);
         c.character = mouth->optString("character").value_or("");
         c.runtime = mouth->optString("runtime").value_or(c.runtime);
-        if (c.runtime != "bigram" && c.runtime != "filter") mouth->fail("runtime", "must be \"bigram\" or \"filter\"");
+        if (c.runtime != "bigram" && c.runtime != "filter")
+            mouth->fail("runtime", "must be \"bigram\" or \"filter\"");
         c.templates = mouth->optString("templates").value_or("");
         c.voice = mouth->optString("voice").value_or(c.voice);
         c.leadSeconds = seconds(*mouth, "lead", c.leadSeconds, -1, 1);
@@ -35,7 +37,8 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         c.record = mouth->optString("record").value_or("");
         c.terminal = mouth->optBool("terminal").value_or(false);
         const double rate = mouth->optNumber("output_rate").value_or(100);
-        if (!(rate >= 10 && rate <= 1000)) mouth->fail("output_rate", "must be within 10 .. 1000 Hz");
+        if (!(rate >= 10 && rate <= 1000))
+            mouth->fail("output_rate", "must be within 10 .. 1000 Hz");
         c.outputRateHz = rate;
         mouth->finish();
     }

@@ -1,16 +1,16 @@
 // lipsyncd: the service. `lipsyncd --config FILE` (default /etc/lipsyncd/lipsyncd.toml).
-#include <lipsyncd/daemon.hpp>
-
-#include <CLI/CLI.hpp>
 #include <systemd/sd-daemon.h>
 
+#include <CLI/CLI.hpp>
 #include <iostream>
+#include <lipsyncd/daemon.hpp>
 
 int main(int argc, char** argv) {
-    CLI::App app{"lipsyncd: the lip-sync service. Plays speech and drives a puppet's mouth in sync;\n"
-                 "controlled over a Unix socket (see `lipsync ctl --help`). Runs under systemd\n"
-                 "(Type=notify) or in the foreground.",
-                 "lipsyncd"};
+    CLI::App app{
+        "lipsyncd: the lip-sync service. Plays speech and drives a puppet's mouth in sync;\n"
+        "controlled over a Unix socket (see `lipsync ctl --help`). Runs under systemd\n"
+        "(Type=notify) or in the foreground.",
+        "lipsyncd"};
     std::string config = "/etc/lipsyncd/lipsyncd.toml";
     app.add_option("--config,-c", config, "Configuration file")->capture_default_str();
     app.set_version_flag("--version", std::string("lipsyncd ") + LIPSYNCD_VERSION);

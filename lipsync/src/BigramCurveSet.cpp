@@ -1,11 +1,9 @@
 // Curve sets as data: JSON, one file per set (format in config/curves/README.md). Loading
 // checks every bigram and pose and names the one at fault, as "FILE: bigrams.aa-bmp.open[2]: ...".
-#include <lipsyncd/lipsync.hpp>
-
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <fstream>
+#include <lipsyncd/lipsync.hpp>
+#include <nlohmann/json.hpp>
 
 namespace lipsyncd::lipsync {
 
@@ -25,7 +23,8 @@ json readJson(const std::filesystem::path& file) {
     }
 }
 
-[[noreturn]] void fail(const std::filesystem::path& file, const std::string& where, const std::string& what) {
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& where,
+                       const std::string& what) {
     throw InputError(file.string() + ": " + where + ": " + what);
 }
 
@@ -51,8 +50,9 @@ std::vector<ControlPoint> readPolygon(const json& points, const std::filesystem:
         if (!(t >= 0 && t <= 1)) fail(file, at, "time must be in [0, 1]");
         if (!(v >= 0 && v <= 1)) fail(file, at, "value must be in [0, 1]");
         if (!out.empty() && !(t > out.back().time))
-            fail(file, at, "times must increase (" + std::to_string(t) + " after " +
-                               std::to_string(out.back().time) + ")");
+            fail(file, at,
+                 "times must increase (" + std::to_string(t) + " after " +
+                     std::to_string(out.back().time) + ")");
         out.push_back({static_cast<float>(t), static_cast<float>(v)});
     }
     if (out.front().time != 0 || out.back().time != 1)
@@ -61,21 +61,26 @@ std::vector<ControlPoint> readPolygon(const json& points, const std::filesystem:
 }
 
 // Reads {"a-b": {"pose": [[t, v], ...]}} into `set`; returns how many bigrams it read.
-std::size_t readBigrams(const json& bigrams, const std::filesystem::path& file, const PoseSet& poses,
-                        const PhonemeSet& phonemes, BigramCurveSet& set) {
-    if (!bigrams.is_object()) fail(file, "bigrams", "expected an object of \"a-b\": {pose: points}");
+std::size_t readBigrams(const json& bigrams, const std::filesystem::path& file,
+                        const PoseSet& poses, const PhonemeSet& phonemes, BigramCurveSet& set) {
+    if (!bigrams.is_object())
+        fail(file, "bigrams", "expected an object of \"a-b\": {pose: points}");
     for (const auto& [key, curves] : bigrams.items()) {
         const auto where = "bigrams." + key;
         const auto dash = key.find('-');
         const auto first = phonemes.find(key.substr(0, dash));
-        const auto second = dash == std::string::npos ? std::nullopt : phonemes.find(key.substr(dash + 1));
+        const auto second =
+            dash == std::string::npos ? std::nullopt : phonemes.find(key.substr(dash + 1));
         if (!first || !second) fail(file, where, "not a pair of phoneme classes ('aa-bmp')");
         if (!curves.is_object()) fail(file, where, "expected an object of pose: points");
-        for (std::size_t p = 0; p < poses.size(); ++p) set.setCurve(*first, *second, p, ControlCurve({{0, 0}, {1, 0}}));
+        for (std::size_t p = 0; p < poses.size(); ++p)
+            set.setCurve(*first, *second, p, ControlCurve({{0, 0}, {1, 0}}));
         for (const auto& [pose, points] : curves.items()) {
             const auto idx = poses.find(pose);
-            if (!idx) fail(file, where + "." + pose, "unknown pose (pose set '" + poses.name() + "')");
-            set.setCurve(*first, *second, *idx, ControlCurve(readPolygon(points, file, where + "." + pose)));
+            if (!idx)
+                fail(file, where + "." + pose, "unknown pose (pose set '" + poses.name() + "')");
+            set.setCurve(*first, *second, *idx,
+                         ControlCurve(readPolygon(points, file, where + "." + pose)));
         }
     }
     return bigrams.size();
@@ -83,8 +88,9 @@ std::size_t readBigrams(const json& bigrams, const std::filesystem::path& file, 
 
 void checkPoseSet(const json& j, const std::filesystem::path& file, const PoseSet& poses) {
     if (j.contains("pose_set") && (!j["pose_set"].is_string() || j["pose_set"] != poses.name()))
-        fail(file, "pose_set", "the curves are for pose set " + j["pose_set"].dump() +
-                                   ", not '" + poses.name() + "'");
+        fail(
+            file, "pose_set",
+            "the curves are for pose set " + j["pose_set"].dump() + ", not '" + poses.name() + "'");
 }
 
 std::filesystem::path resolveBase(const std::string& base, const std::filesystem::path& character) {
@@ -96,18 +102,24 @@ std::filesystem::path resolveBase(const std::string& base, const std::filesystem
 }  // namespace
 
 BigramCurveSet::BigramCurveSet(std::string name, const PoseSet& poses, const PhonemeSet& phonemes)
-    : name_(std::move(name)), classes_(phonemes.size()), poses_(poses.size()),
-      curves_(classes_ * classes_ * poses_), defined_(classes_ * classes_, false) {}
+    : name_(std::move(name)),
+      classes_(phonemes.size()),
+      poses_(poses.size()),
+      curves_(classes_ * classes_ * poses_),
+      defined_(classes_ * classes_, false) {}
 
-const ControlCurve* BigramCurveSet::curve(std::size_t first, std::size_t second, std::size_t pose) const {
+const ControlCurve* BigramCurveSet::curve(std::size_t first, std::size_t second,
+                                          std::size_t pose) const {
     const auto& c = curves_[slot(first, second, pose)];
     return c ? &*c : nullptr;
 }
 
-void BigramCurveSet::setCurve(std::size_t first, std::size_t second, std::size_t pose, ControlCurve curve) {
+void BigramCurveSet::setCurve(std::size_t first, std::size_t second, std::size_t pose,
+                              ControlCurve curve) {
     defined_[first * classes_ + second] = true;
     const auto p = curve.polygon();
-    const bool zero = std::all_of(p.begin(), p.end(), [](const ControlPoint& c) { return c.value == 0; });
+    const bool zero =
+        std::all_of(p.begin(), p.end(), [](const ControlPoint& c) { return c.value == 0; });
     auto& slotRef = curves_[slot(first, second, pose)];
     if (zero)
         slotRef.reset();
@@ -127,7 +139,8 @@ BigramCurveSet BigramCurveSet::loadSet(const std::filesystem::path& file, const 
     const auto j = readJson(file);
     if (j.is_object() && j.value("format", "") == kCharacterFormat) {
         checkHeader(j, file, kCharacterFormat);
-        if (!j.contains("base") || !j["base"].is_string()) fail(file, "base", "missing (the curve set it starts from)");
+        if (!j.contains("base") || !j["base"].is_string())
+            fail(file, "base", "missing (the curve set it starts from)");
         auto set = loadSet(resolveBase(j["base"], file), poses, phonemes, false);
         set.applyOverrides(file, poses, phonemes);
         if (requireEveryPair) set.requireEveryPair(file, phonemes);
@@ -136,22 +149,25 @@ BigramCurveSet BigramCurveSet::loadSet(const std::filesystem::path& file, const 
     checkHeader(j, file, kCurvesFormat);
     checkPoseSet(j, file, poses);
     BigramCurveSet set(j["name"], poses, phonemes);
-    if (j.contains("description") && j["description"].is_string()) set.description_ = j["description"];
+    if (j.contains("description") && j["description"].is_string())
+        set.description_ = j["description"];
     readBigrams(j.value("bigrams", json::object()), file, poses, phonemes, set);
     if (requireEveryPair) set.requireEveryPair(file, phonemes);
     return set;
 }
 
-void BigramCurveSet::requireEveryPair(const std::filesystem::path& file, const PhonemeSet& phonemes) const {
+void BigramCurveSet::requireEveryPair(const std::filesystem::path& file,
+                                      const PhonemeSet& phonemes) const {
     for (std::size_t a = 0; a < phonemes.size(); ++a)
         for (std::size_t b = 0; b < phonemes.size(); ++b)
             if (!defined_[a * classes_ + b])
-                fail(file, "bigrams", "missing pair '" + phonemes[a].name + "-" + phonemes[b].name +
-                                          "' (a set covers every pair; list it with {} if no pose moves)");
+                fail(file, "bigrams",
+                     "missing pair '" + phonemes[a].name + "-" + phonemes[b].name +
+                         "' (a set covers every pair; list it with {} if no pose moves)");
 }
 
-void BigramCurveSet::applyOverrides(const std::filesystem::path& characterFile, const PoseSet& poses,
-                                    const PhonemeSet& phonemes) {
+void BigramCurveSet::applyOverrides(const std::filesystem::path& characterFile,
+                                    const PoseSet& poses, const PhonemeSet& phonemes) {
     const auto j = readJson(characterFile);
     checkHeader(j, characterFile, kCharacterFormat);
     checkPoseSet(j, characterFile, poses);
@@ -163,7 +179,8 @@ BigramCurveSet BigramCurveSet::named(const std::string& nameOrPath, const PoseSe
                                      const PhonemeSet& phonemes) {
     const std::filesystem::path p(nameOrPath);
     if (p.has_extension() || p.has_parent_path()) return load(findDataFile(p), poses, phonemes);
-    return load(findDataFile(std::filesystem::path("curves") / (nameOrPath + ".json")), poses, phonemes);
+    return load(findDataFile(std::filesystem::path("curves") / (nameOrPath + ".json")), poses,
+                phonemes);
 }
 
 namespace {
@@ -178,7 +195,8 @@ json bigramsJson(const BigramCurveSet& s, const PoseSet& poseSet, const PhonemeS
             for (std::size_t p = 0; p < s.poses(); ++p)
                 if (const auto* c = s.curve(a, b, p)) {
                     json points = json::array();
-                    for (const auto& pt : c->polygon()) points.push_back({rounded(pt.time), rounded(pt.value)});
+                    for (const auto& pt : c->polygon())
+                        points.push_back({rounded(pt.time), rounded(pt.value)});
                     curves[poseSet[p].name] = points;
                 }
             bigrams[set[a].name + "-" + set[b].name] = curves;
@@ -206,7 +224,8 @@ void writeSet(const std::filesystem::path& file, const json& header, const json&
 }
 }  // namespace
 
-void BigramCurveSet::save(const std::filesystem::path& file, const PoseSet& poseSet, const PhonemeSet& set) const {
+void BigramCurveSet::save(const std::filesystem::path& file, const PoseSet& poseSet,
+                          const PhonemeSet& set) const {
     json header = json::object();
     header["format"] = kCurvesFormat;
     header["version"] = kVersion;
@@ -216,8 +235,9 @@ void BigramCurveSet::save(const std::filesystem::path& file, const PoseSet& pose
     writeSet(file, header, bigramsJson(*this, poseSet, set, std::nullopt));
 }
 
-void BigramCurveSet::saveAdditions(const std::filesystem::path& file, const std::string& base, std::size_t onlyWith,
-                                   const PoseSet& poseSet, const PhonemeSet& set) const {
+void BigramCurveSet::saveAdditions(const std::filesystem::path& file, const std::string& base,
+                                   std::size_t onlyWith, const PoseSet& poseSet,
+                                   const PhonemeSet& set) const {
     json header = json::object();
     header["format"] = kCharacterFormat;
     header["version"] = kVersion;

@@ -1,7 +1,6 @@
 // The runtime of section 2.2 over a whole schedule: the steps in the paper's order.
-#include <lipsyncd/lipsync.hpp>
-
 #include <cmath>
+#include <lipsyncd/lipsync.hpp>
 
 namespace lipsyncd::lipsync {
 
@@ -26,7 +25,8 @@ PoseTrack animate(std::span<const PhonemeSegment> schedule, const BigramCurveSet
         return empty;
     }
     const double start = schedule.front().start, end = schedule.back().end;
-    const auto frames = static_cast<std::size_t>(std::floor((end - start) * config.outputRate + 1e-9)) + 1;
+    const auto frames =
+        static_cast<std::size_t>(std::floor((end - start) * config.outputRate + 1e-9)) + 1;
     PoseCurves curves(poses.size(), config.outputRate, start, 0, frames);
     stitchBigrams(schedule, set, phonemes, curves);
     if (config.smoothing)

@@ -4,10 +4,9 @@
 // the end points so the curve starts and ends where the polygon does. Times increase along
 // the polygon, so the curve's time is monotone and the curve is a function of time; it is
 // sampled once here and read by linear interpolation at run time.
-#include <lipsyncd/lipsync.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <lipsyncd/lipsync.hpp>
 
 namespace lipsyncd::lipsync {
 
@@ -34,7 +33,8 @@ ControlCurve::ControlCurve(std::vector<ControlPoint> polygon) : polygon_(std::mo
     std::vector<ControlPoint> dense;
     for (std::size_t j = 0; j + 3 < q.size(); ++j)
         for (int k = 0; k < kStepsPerSpan; ++k)
-            dense.push_back(blend(q[j], q[j + 1], q[j + 2], q[j + 3], static_cast<float>(k) / kStepsPerSpan));
+            dense.push_back(
+                blend(q[j], q[j + 1], q[j + 2], q[j + 3], static_cast<float>(k) / kStepsPerSpan));
     dense.push_back(polygon_.back());
     samples_.resize(kSamples);
     std::size_t at = 0;

@@ -4,10 +4,9 @@
 // vertices make the B-spline pass through the target, since a cubic B-spline only
 // approximates single vertices. The ends sit halfway to rest: max-stitching with the
 // neighbouring bigrams supplies the rest of each transition (section 2.2.1).
+#include <algorithm>
 #include <lipsyncd/lipsync.hpp>
 #include <lipsyncd/toml_table.hpp>
-
-#include <algorithm>
 
 namespace lipsyncd::lipsync {
 
@@ -20,15 +19,18 @@ struct Rules {
     float closureValue = 1, leadAmount = 0, anticipation = 0, carryover = 0;
 };
 
-std::size_t poseIndex(const TomlTable& t, const std::string& key, const std::string& name, const PoseSet& poses) {
+std::size_t poseIndex(const TomlTable& t, const std::string& key, const std::string& name,
+                      const PoseSet& poses) {
     const auto i = poses.find(name);
     if (!i) t.fail(key, "unknown pose '" + name + "' (pose set '" + poses.name() + "')");
     return *i;
 }
 
-std::vector<std::size_t> poseList(const TomlTable& t, const std::string& key, const PoseSet& poses) {
+std::vector<std::size_t> poseList(const TomlTable& t, const std::string& key,
+                                  const PoseSet& poses) {
     std::vector<std::size_t> out;
-    for (const auto& n : t.optStringArray(key).value_or(std::vector<std::string>{})) out.push_back(poseIndex(t, key, n, poses));
+    for (const auto& n : t.optStringArray(key).value_or(std::vector<std::string>{}))
+        out.push_back(poseIndex(t, key, n, poses));
     return out;
 }
 
@@ -38,7 +40,8 @@ float fraction(const TomlTable& t, const std::string& key) {
     return static_cast<float>(v);
 }
 
-void readTargets(const TomlTable& table, const PoseSet& poses, const PhonemeSet& phonemes, Rules& r) {
+void readTargets(const TomlTable& table, const PoseSet& poses, const PhonemeSet& phonemes,
+                 Rules& r) {
     r.targets.assign(phonemes.size(), std::vector<float>(poses.size(), 0.0f));
     std::vector<bool> seen(phonemes.size(), false);
     for (const auto& cls : table.keys()) {
@@ -47,11 +50,13 @@ void readTargets(const TomlTable& table, const PoseSet& poses, const PhonemeSet&
         seen[*c] = true;
         const auto target = table.optTable(cls);
         if (!target) table.fail(cls, "expected a table of pose = weight");
-        for (const auto& pose : target->keys()) r.targets[*c][poseIndex(*target, pose, pose, poses)] = fraction(*target, pose);
+        for (const auto& pose : target->keys())
+            r.targets[*c][poseIndex(*target, pose, pose, poses)] = fraction(*target, pose);
         target->finish();
     }
     for (std::size_t c = 0; c < phonemes.size(); ++c)
-        if (!seen[c]) table.fail("", "no target for class '" + phonemes[c].name + "' (use {} for none)");
+        if (!seen[c])
+            table.fail("", "no target for class '" + phonemes[c].name + "' (use {} for none)");
 }
 
 Rules readRules(const TomlTable& root, const PoseSet& poses, const PhonemeSet& phonemes) {
@@ -59,8 +64,8 @@ Rules readRules(const TomlTable& root, const PoseSet& poses, const PhonemeSet& p
     r.firstCentre = fraction(root, "first_centre");
     r.secondCentre = fraction(root, "second_centre");
     r.hold = fraction(root, "hold");
-    if (!(r.hold > 0 && r.firstCentre - r.hold > 0 && r.firstCentre + r.hold < r.secondCentre - r.hold &&
-          r.secondCentre + r.hold < 1))
+    if (!(r.hold > 0 && r.firstCentre - r.hold > 0 &&
+          r.firstCentre + r.hold < r.secondCentre - r.hold && r.secondCentre + r.hold < 1))
         root.fail("hold", "the two held plateaus must lie inside (0, 1) and apart");
     const auto targets = root.optTable("targets");
     if (!targets) root.fail("targets", "missing [targets]");
@@ -90,7 +95,9 @@ Rules readRules(const TomlTable& root, const PoseSet& poses, const PhonemeSet& p
     return r;
 }
 
-bool contains(const std::vector<std::size_t>& v, std::size_t x) { return std::find(v.begin(), v.end(), x) != v.end(); }
+bool contains(const std::vector<std::size_t>& v, std::size_t x) {
+    return std::find(v.begin(), v.end(), x) != v.end();
+}
 
 // The pose's target in phoneme `c`, with the closure rule applied.
 float targetOf(const Rules& r, std::size_t c, std::size_t pose) {
@@ -101,11 +108,12 @@ float targetOf(const Rules& r, std::size_t c, std::size_t pose) {
     return r.targets[c][pose];
 }
 
-std::vector<ControlPoint> polygonFor(const Rules& r, const PhonemeSet& set, std::size_t a, std::size_t b,
-                                     std::size_t pose) {
+std::vector<ControlPoint> polygonFor(const Rules& r, const PhonemeSet& set, std::size_t a,
+                                     std::size_t b, std::size_t pose) {
     float va = targetOf(r, a, pose), vb = targetOf(r, b, pose);
     const bool aVowel = set[a].vowel, bVowel = set[b].vowel;
-    const bool aConsonant = !aVowel && a != set.silence(), bConsonant = !bVowel && b != set.silence();
+    const bool aConsonant = !aVowel && a != set.silence(),
+               bConsonant = !bVowel && b != set.silence();
     if (contains(r.roundingPoses, pose)) {
         if (aConsonant && bVowel) va = std::max(va, r.anticipation * vb);
         if (aVowel && bConsonant) vb = std::max(vb, r.carryover * va);
@@ -115,8 +123,8 @@ std::vector<ControlPoint> polygonFor(const Rules& r, const PhonemeSet& set, std:
         cb = std::max(r.firstCentre + 2 * r.hold + 0.01, cb - r.leadAmount);
     const auto f = [](double x) { return static_cast<float>(x); };
     const double ca = r.firstCentre, h = r.hold;
-    return {{0, va / 2},         {f(ca - h), va}, {f(ca), va}, {f(ca + h), va},
-            {f(cb - h), vb},     {f(cb), vb},     {f(cb + h), vb}, {1, vb / 2}};
+    return {{0, va / 2},     {f(ca - h), va}, {f(ca), va},     {f(ca + h), va},
+            {f(cb - h), vb}, {f(cb), vb},     {f(cb + h), vb}, {1, vb / 2}};
 }
 }  // namespace
 
@@ -124,7 +132,8 @@ BigramCurveSet generateCurveSet(const std::filesystem::path& rulesFile, const Po
                                 const PhonemeSet& phonemes) {
     const auto root = TomlTable::parseFile(rulesFile);
     const auto poseSet = root.getString("pose_set");
-    if (poseSet != poses.name()) root.fail("pose_set", "rules are for '" + poseSet + "', poses are '" + poses.name() + "'");
+    if (poseSet != poses.name())
+        root.fail("pose_set", "rules are for '" + poseSet + "', poses are '" + poses.name() + "'");
     const Rules rules = readRules(root, poses, phonemes);
     BigramCurveSet set(root.getString("name"), poses, phonemes);
     set.description() = root.optString("description").value_or("");

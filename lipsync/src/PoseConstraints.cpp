@@ -2,9 +2,8 @@
 // the lower-priority curve is reduced so that the sum is C: c_b' = c_b − (c_a + c_b − C).
 // Constraints are applied highest winning priority first (PoseSet orders them), and only ever
 // lower a value, so a constraint met stays met.
-#include <lipsyncd/lipsync.hpp>
-
 #include <algorithm>
+#include <lipsyncd/lipsync.hpp>
 
 namespace lipsyncd::lipsync {
 

@@ -1,9 +1,8 @@
 // Pose sets as data (config/poses/*.toml), read strictly: unknown keys, unknown poses, repeated
 // names and out-of-range numbers stop loading with the file and line.
+#include <algorithm>
 #include <lipsyncd/lipsync.hpp>
 #include <lipsyncd/toml_table.hpp>
-
-#include <algorithm>
 
 namespace lipsyncd::lipsync {
 
@@ -42,7 +41,8 @@ std::vector<PoseConstraint> readConstraints(const TomlTable& root, const std::ve
         if (!names || names->size() != 2) c.fail("poses", "must name exactly two poses");
         std::size_t idx[2];
         for (int i = 0; i < 2; ++i) {
-            auto it = std::find_if(poses.begin(), poses.end(), [&](const Pose& p) { return p.name == (*names)[i]; });
+            auto it = std::find_if(poses.begin(), poses.end(),
+                                   [&](const Pose& p) { return p.name == (*names)[i]; });
             if (it == poses.end()) c.fail("poses", "unknown pose '" + (*names)[i] + "'");
             idx[i] = static_cast<std::size_t>(it - poses.begin());
         }
@@ -72,7 +72,8 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
     for (const auto& t : root.tableArray("pose")) {
         Pose p;
         p.name = t.getString("name");
-        if (std::any_of(poses.begin(), poses.end(), [&](const Pose& q) { return q.name == p.name; }))
+        if (std::any_of(poses.begin(), poses.end(),
+                        [&](const Pose& q) { return q.name == p.name; }))
             t.fail("name", "pose '" + p.name + "' is defined twice");
         p.priority = static_cast<int>(t.optInteger("priority").value_or(0));
         p.speedLimit = positive(t, "speed_limit", speed);

@@ -4,9 +4,8 @@
 // a constraint again; so, when constraints are on, poses are placed highest priority first
 // (the order constraints resolve in) under a ceiling that keeps every constraint satisfiable
 // (ceilingFor). Starting from a frame that meets the constraints, every frame then meets both.
-#include <lipsyncd/lipsync.hpp>
-
 #include <algorithm>
+#include <lipsyncd/lipsync.hpp>
 #include <numeric>
 
 namespace lipsyncd::lipsync {
@@ -38,8 +37,9 @@ void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const floa
     const std::size_t n = poses.size();
     std::vector<std::size_t> order(n);
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t a, std::size_t b) { return poses[a].priority > poses[b].priority; });
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return poses[a].priority > poses[b].priority;
+    });
     const double dt = 1.0 / curves.rate;
     std::vector<float> prev(previous.begin(), previous.end()), now(n);
     for (std::size_t f = fromFrame; f < curves.frames; ++f) {
@@ -47,8 +47,7 @@ void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const floa
             const auto step = static_cast<float>(poses[p].speedLimit * dt);
             const float lo = std::max(0.0f, prev[p] - step);
             float hi = std::min(1.0f, prev[p] + step);
-            if (keepConstraints)
-                hi = std::min(hi, ceilingFor(poses, p, prev, now, dt));
+            if (keepConstraints) hi = std::min(hi, ceilingFor(poses, p, prev, now, dt));
             // hi < lo only when the previous frame broke a constraint; the constraint wins.
             now[p] = std::min(std::max(curves.values[p][f], lo), std::max(0.0f, hi));
         }

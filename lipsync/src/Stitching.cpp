@@ -2,16 +2,18 @@
 // time-warped onto its span, overlapping curves of one pose stitched with max() so that no
 // bigram's motion is damped by its neighbours ("we choose the maximum value over linear
 // blending or averaging ... so that the original information is preserved").
-#include <lipsyncd/lipsync.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <lipsyncd/lipsync.hpp>
 
 namespace lipsyncd::lipsync {
 
 PoseCurves::PoseCurves(std::size_t poses, double rate_, double startTime_, std::size_t firstFrame_,
                        std::size_t frames_)
-    : startTime(startTime_), firstFrame(firstFrame_), rate(rate_), frames(frames_),
+    : startTime(startTime_),
+      firstFrame(firstFrame_),
+      rate(rate_),
+      frames(frames_),
       values(poses, std::vector<float>(frames_, 0.0f)) {}
 
 namespace {
@@ -19,7 +21,8 @@ std::size_t classOf(const PhonemeSegment& s, const PhonemeSet& phonemes) {
     const auto idx = phonemes.find(s.phoneme);
     if (!idx)
         throw InputError("schedule: '" + s.phoneme + "' at " + std::to_string(s.start) +
-                         " s is not a class of the phoneme set in use (map the schedule first; --phonemes picks the set)");
+                         " s is not a class of the phoneme set in use (map the schedule first; "
+                         "--phonemes picks the set)");
     return *idx;
 }
 

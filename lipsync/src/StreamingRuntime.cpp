@@ -3,18 +3,21 @@
 // no later segment can change any more: those older than the newest boundary minus the delay.
 // The window keeps enough past (a segment, the smoothing window and a margin) for every step
 // to see what the offline pass sees, and the speed limit continues from the last frame out.
-#include <lipsyncd/lipsync.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <lipsyncd/lipsync.hpp>
 
 namespace lipsyncd::lipsync {
 
 StreamingRuntime::StreamingRuntime(const BigramCurveSet& set, const PoseSet& poses,
                                    double delaySeconds, const RuntimeConfig& config,
                                    const PhonemeSet& phonemes)
-    : set_(&set), poses_(&poses), phonemes_(&phonemes), config_(config),
-      delay_(std::max(0.0, delaySeconds)), last_(poses.size(), 0.0f) {}
+    : set_(&set),
+      poses_(&poses),
+      phonemes_(&phonemes),
+      config_(config),
+      delay_(std::max(0.0, delaySeconds)),
+      last_(poses.size(), 0.0f) {}
 
 void StreamingRuntime::push(const PhonemeSegment& segment, PoseTrack& out) {
     if (!started_) {
@@ -45,14 +48,16 @@ void StreamingRuntime::finish(PoseTrack& out) {
     if (!window_.empty()) emitUntil(window_.back().end, true, out);
 }
 
-void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out, const PhonemeSegment* open) {
+void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
+                                 const PhonemeSegment* open) {
     if (out.poses.empty()) out.poses = poses_->names();
     if (window_.empty() && !open) return;
     const double rate = config_.outputRate;
     const auto lastFrame = static_cast<long long>(std::floor((until - origin_) * rate + 1e-9));
     if (lastFrame < static_cast<long long>(emitted_)) return;
     const double windowStart = window_.empty() ? open->start : window_.front().start;
-    const auto firstFrame = static_cast<std::size_t>(std::max(0.0, std::ceil((windowStart - origin_) * rate - 1e-9)));
+    const auto firstFrame =
+        static_cast<std::size_t>(std::max(0.0, std::ceil((windowStart - origin_) * rate - 1e-9)));
     // Work past the last frame to let out by a smoothing window, so that a curve cut short
     // there does not look like a peak to the valley smoothing.
     const double knownEnd = open ? open->end : window_.back().end;
@@ -64,12 +69,14 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out, const
 
     std::vector<PhonemeSegment> schedule(window_.begin(), window_.end());
     const bool causal = delay_ == 0 && !final;
-    if (causal) {  // what comes next is unknown: assume the last phoneme goes on, for a typical length
+    if (causal) {  // what comes next is unknown: assume the last phoneme goes on, for a typical
+                   // length
         double total = 0;
         for (const auto& s : window_) total += s.duration();
         const double typical = window_.empty() ? 0.1 : total / static_cast<double>(window_.size());
         if (open) {
-            schedule.push_back({open->start, std::max(open->end, open->start + typical), open->phoneme, 0});
+            schedule.push_back(
+                {open->start, std::max(open->end, open->start + typical), open->phoneme, 0});
         } else {
             const auto& last = window_.back();
             schedule.push_back({last.end, last.end + typical, last.phoneme, 0});
@@ -100,7 +107,8 @@ double StreamingRuntime::longestWindow() const {
 }
 
 void StreamingRuntime::dropOldSegments() {
-    const double keepFrom = origin_ + static_cast<double>(emitted_) / config_.outputRate - longestWindow() - 0.05;
+    const double keepFrom =
+        origin_ + static_cast<double>(emitted_) / config_.outputRate - longestWindow() - 0.05;
     while (window_.size() > 3 && window_[2].start <= keepFrom) {
         window_.erase(window_.begin());
         atStart_ = false;

@@ -2,9 +2,8 @@
 // c(t_a), c(t_b) fall inside it, the values between them are replaced by the line between the
 // maxima, which "smoothes out the valley between two maxima and therefore helps reduce high
 // frequency lip movements". Only valleys are filled: a value above the line stays.
-#include <lipsyncd/lipsync.hpp>
-
 #include <algorithm>
+#include <lipsyncd/lipsync.hpp>
 
 namespace lipsyncd::lipsync {
 

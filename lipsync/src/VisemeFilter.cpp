@@ -4,10 +4,9 @@
 // ("a heavier weight on the succeeding frame ... the lips tend to aim at the next phoneme"),
 // then averaged in groups of slots down to the output rate (their motion blur). It looks 30 ms
 // ahead, where the bigram runtime needs the next phoneme's end: the lowest-latency option.
-#include <lipsyncd/lipsync.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <lipsyncd/lipsync.hpp>
 
 namespace lipsyncd::lipsync {
 
@@ -16,7 +15,8 @@ constexpr double kSlotRate = 100;  // one viseme per 10 ms, as the paper's align
 
 // The viseme of each class: the pose its self-bigram (c, c) holds at the first phoneme's
 // centre, i.e. what the curve set shows for that phoneme held (the paper's "average viseme").
-std::vector<std::vector<float>> visemes(const BigramCurveSet& set, std::size_t classes, std::size_t poses) {
+std::vector<std::vector<float>> visemes(const BigramCurveSet& set, std::size_t classes,
+                                        std::size_t poses) {
     std::vector<std::vector<float>> v(classes, std::vector<float>(poses, 0.0f));
     for (std::size_t c = 0; c < classes; ++c)
         for (std::size_t p = 0; p < poses; ++p)
@@ -26,7 +26,8 @@ std::vector<std::vector<float>> visemes(const BigramCurveSet& set, std::size_t c
 }  // namespace
 
 PoseTrack animateFilter(std::span<const PhonemeSegment> schedule, const BigramCurveSet& set,
-                        const PoseSet& poses, const RuntimeConfig& config, const PhonemeSet& phonemes) {
+                        const PoseSet& poses, const RuntimeConfig& config,
+                        const PhonemeSet& phonemes) {
     PoseTrack track;
     track.poses = poses.names();
     if (schedule.empty()) return track;
@@ -38,26 +39,32 @@ PoseTrack animateFilter(std::span<const PhonemeSegment> schedule, const BigramCu
         const double t = start + static_cast<double>(i) / kSlotRate;
         while (seg + 1 < schedule.size() && t >= schedule[seg].end) ++seg;
         const auto c = phonemes.find(schedule[seg].phoneme);
-        if (!c) throw InputError("schedule: '" + schedule[seg].phoneme + "' is not a phoneme class");
+        if (!c)
+            throw InputError("schedule: '" + schedule[seg].phoneme + "' is not a phoneme class");
         cls[i] = *c;
     }
     // Beyond either end the mouth is at rest (silence).
     const auto at = [&](long long i, std::size_t p) {
-        return i < 0 || i >= static_cast<long long>(slots) ? 0.0f : table[cls[static_cast<std::size_t>(i)]][p];
+        return i < 0 || i >= static_cast<long long>(slots)
+                   ? 0.0f
+                   : table[cls[static_cast<std::size_t>(i)]][p];
     };
     std::vector<std::vector<float>> filtered(slots, std::vector<float>(poses.size()));
     for (std::size_t i = 0; i < slots; ++i)
         for (std::size_t p = 0; p < poses.size(); ++p) {
             const auto k = static_cast<long long>(i);
-            filtered[i][p] = std::clamp(0.1f * at(k - 1, p) + 0.5f * at(k, p) + 0.3f * at(k + 1, p) + 0.1f * at(k + 3, p),
-                                        0.0f, 1.0f);
+            filtered[i][p] = std::clamp(
+                0.1f * at(k - 1, p) + 0.5f * at(k, p) + 0.3f * at(k + 1, p) + 0.1f * at(k + 3, p),
+                0.0f, 1.0f);
         }
     // Down to the output rate: each output frame averages the slots nearest to it.
-    const auto frames = static_cast<std::size_t>(std::floor((end - start) * config.outputRate + 1e-9)) + 1;
+    const auto frames =
+        static_cast<std::size_t>(std::floor((end - start) * config.outputRate + 1e-9)) + 1;
     std::vector<float> row(poses.size());
     for (std::size_t f = 0; f < frames; ++f) {
         const double t = static_cast<double>(f) / config.outputRate;
-        const auto from = static_cast<std::size_t>(std::max(0.0, std::round((t - 0.5 / config.outputRate) * kSlotRate)));
+        const auto from = static_cast<std::size_t>(
+            std::max(0.0, std::round((t - 0.5 / config.outputRate) * kSlotRate)));
         auto to = static_cast<std::size_t>(std::round((t + 0.5 / config.outputRate) * kSlotRate));
         to = std::clamp(to, from + 1, slots);
         std::fill(row.begin(), row.end(), 0.0f);

@@ -2,16 +2,17 @@
 // included, the command stays within [min, max] and moves no faster than the slew limit; a
 // non-finite input holds the last good target. Servos at rest relax after an idle time (no
 // pulses, no buzzing) until the mouth moves again.
-#include <lipsyncd/output.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <lipsyncd/output.hpp>
 
 namespace lipsyncd::output {
 
 SwitchLogic::SwitchLogic(const ActuatorConfig& c)
-    : onAbove_(c.threshold + c.hysteresis / 2), offBelow_(c.threshold - c.hysteresis / 2),
-      minOn_(c.minOnSeconds), minOff_(c.minOffSeconds) {}
+    : onAbove_(c.threshold + c.hysteresis / 2),
+      offBelow_(c.threshold - c.hysteresis / 2),
+      minOn_(c.minOnSeconds),
+      minOff_(c.minOffSeconds) {}
 
 bool SwitchLogic::update(double time, double value) {
     // A valve must not chatter: a change needs the hysteresis crossed and the minimum time in
@@ -28,7 +29,10 @@ bool SwitchLogic::update(double time, double value) {
 }
 
 ActuatorChannel::ActuatorChannel(const ActuatorConfig& config, std::vector<std::size_t> poseIndex)
-    : config_(config), poseIndex_(std::move(poseIndex)), value_(config.rest), lastTarget_(config.rest) {
+    : config_(config),
+      poseIndex_(std::move(poseIndex)),
+      value_(config.rest),
+      lastTarget_(config.rest) {
     if (config_.backend == Backend::Switch) switch_.emplace(config_);
 }
 
@@ -47,9 +51,13 @@ ActuatorCommand ActuatorChannel::step(double time, std::span<const float> weight
     return moveToward(time, target);
 }
 
-ActuatorCommand ActuatorChannel::stepToRest(double time) { return moveToward(time, config_.rest); }
+ActuatorCommand ActuatorChannel::stepToRest(double time) {
+    return moveToward(time, config_.rest);
+}
 
-bool ActuatorChannel::atRest() const { return std::abs(value_ - config_.rest) < 1e-9; }
+bool ActuatorChannel::atRest() const {
+    return std::abs(value_ - config_.rest) < 1e-9;
+}
 
 ActuatorCommand ActuatorChannel::moveToward(double time, double target) {
     target = std::clamp(target, config_.min, config_.max);

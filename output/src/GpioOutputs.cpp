@@ -1,18 +1,17 @@
 // GPIO over libgpiod 1.6 (Debian 12): servo pulses in software and on/off switches. The lines
 // are opened once, as outputs, low; a missing chip or line is an InputError naming both.
-#include <lipsyncd/output.hpp>
-
 #include <gpiod.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <lipsyncd/output.hpp>
 
 namespace lipsyncd::output {
 
 namespace {
 class LibgpiodLine : public GpioLine {
-public:
+  public:
     LibgpiodLine(gpiod_chip* chip, gpiod_line* line) : chip_(chip), line_(line) {}
     ~LibgpiodLine() override {
         gpiod_line_set_value(line_, 0);
@@ -21,13 +20,14 @@ public:
     }
     void set(bool high) override { gpiod_line_set_value(line_, high ? 1 : 0); }
 
-private:
+  private:
     gpiod_chip* chip_;
     gpiod_line* line_;
 };
 }  // namespace
 
-std::unique_ptr<GpioLine> openGpioLine(const std::string& chipName, unsigned offset, const std::string& consumer) {
+std::unique_ptr<GpioLine> openGpioLine(const std::string& chipName, unsigned offset,
+                                       const std::string& consumer) {
     gpiod_chip* chip = gpiod_chip_open_lookup(chipName.c_str());
     if (!chip)
         throw InputError("GPIO chip '" + chipName + "': cannot open (" + std::strerror(errno) +
@@ -37,14 +37,14 @@ std::unique_ptr<GpioLine> openGpioLine(const std::string& chipName, unsigned off
         const std::string why = std::strerror(errno);
         const unsigned lines = gpiod_chip_num_lines(chip);
         gpiod_chip_close(chip);
-        throw InputError("GPIO chip '" + chipName + "' line " + std::to_string(offset) + ": " + why + " (the chip has " +
-                         std::to_string(lines) + " lines)");
+        throw InputError("GPIO chip '" + chipName + "' line " + std::to_string(offset) + ": " +
+                         why + " (the chip has " + std::to_string(lines) + " lines)");
     }
     if (gpiod_line_request_output(line, consumer.c_str(), 0) != 0) {
         const std::string why = std::strerror(errno);
         gpiod_chip_close(chip);
-        throw InputError("GPIO chip '" + chipName + "' line " + std::to_string(offset) + ": cannot claim it (" + why +
-                         "; another program may hold it)");
+        throw InputError("GPIO chip '" + chipName + "' line " + std::to_string(offset) +
+                         ": cannot claim it (" + why + "; another program may hold it)");
     }
     return std::make_unique<LibgpiodLine>(chip, line);
 }
@@ -62,7 +62,9 @@ std::vector<std::string> listGpioChips() {
             const char* name = gpiod_line_name(line);
             const char* user = gpiod_line_consumer(line);
             out.push_back("    line " + std::to_string(i) + ": " + (name ? name : "unnamed") +
-                          (gpiod_line_is_used(line) ? std::string(" (used by ") + (user ? user : "kernel") + ")" : ""));
+                          (gpiod_line_is_used(line)
+                               ? std::string(" (used by ") + (user ? user : "kernel") + ")"
+                               : ""));
         }
     }
     gpiod_chip_iter_free(iter);
@@ -77,7 +79,8 @@ std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> realOpener(const
 }
 }  // namespace
 
-GpioServoSink::GpioServoSink(const Puppet& puppet, std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open) {
+GpioServoSink::GpioServoSink(const Puppet& puppet,
+                             std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open) {
     if (!open) open = realOpener(puppet);
     std::vector<ServoPwm::Servo> servos;
     double frequency = 50;
@@ -97,10 +100,12 @@ void GpioServoSink::write(double, std::span<const ActuatorCommand> commands) {
         pwm_->set(k, commands[actuator_[k]].value, commands[actuator_[k]].active);
 }
 
-GpioSwitchSink::GpioSwitchSink(const Puppet& puppet, std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open) {
+GpioSwitchSink::GpioSwitchSink(
+    const Puppet& puppet, std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open) {
     if (!open) open = realOpener(puppet);
     for (std::size_t i = 0; i < puppet.actuators.size(); ++i)
-        if (puppet.actuators[i].backend == Backend::Switch) lines_.emplace_back(i, open(puppet.actuators[i]));
+        if (puppet.actuators[i].backend == Backend::Switch)
+            lines_.emplace_back(i, open(puppet.actuators[i]));
     state_.assign(lines_.size(), -1);
 }
 
@@ -116,13 +121,16 @@ void GpioSwitchSink::write(double, std::span<const ActuatorCommand> commands) {
 
 namespace lipsyncd::output {
 
-void addHardwareSinks(PuppetDriver& driver, const Puppet& puppet, std::function<void(const std::string&)> log) {
+void addHardwareSinks(PuppetDriver& driver, const Puppet& puppet,
+                      std::function<void(const std::string&)> log) {
     const auto uses = [&](Backend b) {
-        return std::any_of(puppet.actuators.begin(), puppet.actuators.end(), [&](const ActuatorConfig& a) { return a.backend == b; });
+        return std::any_of(puppet.actuators.begin(), puppet.actuators.end(),
+                           [&](const ActuatorConfig& a) { return a.backend == b; });
     };
     if (uses(Backend::Servo)) driver.addSink(std::make_unique<GpioServoSink>(puppet));
     if (uses(Backend::Switch)) driver.addSink(std::make_unique<GpioSwitchSink>(puppet));
-    for (const auto& h : puppet.hidDevices) driver.addSink(std::make_unique<HidSink>(puppet, h, openHidapiDevice, log));
+    for (const auto& h : puppet.hidDevices)
+        driver.addSink(std::make_unique<HidSink>(puppet, h, openHidapiDevice, log));
 }
 
 }  // namespace lipsyncd::output

@@ -1,10 +1,9 @@
 // Puppet files (config/puppets/*.toml), read strictly: unknown keys, wrong types, duplicate
 // GPIO lines, min > max, a rest outside the limits: each stops loading with the file and line.
-#include <lipsyncd/output.hpp>
-#include <lipsyncd/toml_table.hpp>
-
 #include <algorithm>
 #include <iomanip>
+#include <lipsyncd/output.hpp>
+#include <lipsyncd/toml_table.hpp>
 #include <ostream>
 #include <set>
 
@@ -49,7 +48,8 @@ void readBackendSettings(const TomlTable& t, ActuatorConfig& a) {
         a.pulseMinUs = number(t, "pulse_min_us", 1000, 100, 3000);
         a.pulseMaxUs = number(t, "pulse_max_us", 2000, 100, 3000);
         a.frequencyHz = number(t, "frequency", 50, 10, 400);
-        if (1e6 / a.frequencyHz < std::max(a.pulseMinUs, a.pulseMaxUs)) t.fail("frequency", "the period is shorter than a pulse");
+        if (1e6 / a.frequencyHz < std::max(a.pulseMinUs, a.pulseMaxUs))
+            t.fail("frequency", "the period is shorter than a pulse");
     }
     if (a.backend == Backend::Switch) {
         a.threshold = t.getNumber("threshold");
@@ -69,7 +69,8 @@ ActuatorConfig readActuator(const TomlTable& t) {
     a.trim = t.optNumber("trim").value_or(0);
     if (const auto gains = t.optTable("gains"))
         for (const auto& pose : gains->keys()) a.gains.emplace_back(pose, gains->getNumber(pose));
-    if (a.gains.empty()) t.fail("gains", "missing: which poses move this actuator (gains = { open = 1.0 })");
+    if (a.gains.empty())
+        t.fail("gains", "missing: which poses move this actuator (gains = { open = 1.0 })");
     a.invert = t.optBool("invert").value_or(false);
     a.min = t.getNumber("min");
     a.max = t.getNumber("max");
@@ -113,20 +114,27 @@ void checkDuplicates(const Puppet& p, const TomlTable& root) {
     std::set<std::string> names;
     for (const auto& a : p.actuators) {
         if (!names.insert(a.name).second)
-            throw InputError(p.source.string(), a.line, "actuator '" + a.name + "' is defined twice");
-        if ((a.backend == Backend::Servo || a.backend == Backend::Switch) && !gpio.insert({a.chip, a.gpioLine}).second)
             throw InputError(p.source.string(), a.line,
-                             "GPIO " + a.chip + " line " + std::to_string(a.gpioLine) + " is used by two actuators");
+                             "actuator '" + a.name + "' is defined twice");
+        if ((a.backend == Backend::Servo || a.backend == Backend::Switch) &&
+            !gpio.insert({a.chip, a.gpioLine}).second)
+            throw InputError(p.source.string(), a.line,
+                             "GPIO " + a.chip + " line " + std::to_string(a.gpioLine) +
+                                 " is used by two actuators");
         if (a.backend == Backend::Hid) {
-            const auto dev = std::find_if(p.hidDevices.begin(), p.hidDevices.end(),
-                                          [&](const HidDeviceConfig& h) { return h.name == a.hidDevice; });
+            const auto dev =
+                std::find_if(p.hidDevices.begin(), p.hidDevices.end(),
+                             [&](const HidDeviceConfig& h) { return h.name == a.hidDevice; });
             if (dev == p.hidDevices.end())
-                throw InputError(p.source.string(), a.line, "actuator '" + a.name + "': no [[hid]] named '" + a.hidDevice + "'");
+                throw InputError(
+                    p.source.string(), a.line,
+                    "actuator '" + a.name + "': no [[hid]] named '" + a.hidDevice + "'");
             const std::size_t width = dev->encoding == HidEncoding::U8 ? 1 : 2;
             if ((a.hidChannel + 1) * width > dev->reportSize)
-                throw InputError(p.source.string(), a.line, "actuator '" + a.name + "': channel " +
-                                                                std::to_string(a.hidChannel) + " does not fit a " +
-                                                                std::to_string(dev->reportSize) + "-byte report");
+                throw InputError(p.source.string(), a.line,
+                                 "actuator '" + a.name + "': channel " +
+                                     std::to_string(a.hidChannel) + " does not fit a " +
+                                     std::to_string(dev->reportSize) + "-byte report");
         }
     }
     (void)root;
@@ -152,8 +160,9 @@ void Puppet::checkPoses(std::span<const std::string> poses) const {
     for (const auto& a : actuators)
         for (const auto& [pose, gain] : a.gains)
             if (std::find(poses.begin(), poses.end(), pose) == poses.end())
-                throw InputError(source.string(), a.line, "actuator '" + a.name + "': pose '" + pose +
-                                                              "' is not among the weights' poses");
+                throw InputError(source.string(), a.line,
+                                 "actuator '" + a.name + "': pose '" + pose +
+                                     "' is not among the weights' poses");
 }
 
 void Puppet::describe(std::ostream& out) const {
@@ -162,24 +171,28 @@ void Puppet::describe(std::ostream& out) const {
         << " actuator(s), rest after " << stallTimeout << " s without input\n";
     for (const auto& a : actuators) {
         out << "  " << a.name << " [" << kBackend[static_cast<int>(a.backend)];
-        if (a.backend == Backend::Servo || a.backend == Backend::Switch) out << " " << a.chip << " line " << a.gpioLine;
+        if (a.backend == Backend::Servo || a.backend == Backend::Switch)
+            out << " " << a.chip << " line " << a.gpioLine;
         if (a.backend == Backend::Hid) out << " " << a.hidDevice << " channel " << a.hidChannel;
         out << "]\n    value = " << a.neutral + a.trim;
-        for (const auto& [pose, gain] : a.gains) out << (gain < 0 ? " - " : " + ") << std::abs(gain) << "·" << pose;
-        out << (a.invert ? ", inverted" : "") << "; limits " << a.min << " .. " << a.max << ", rest " << a.rest
-            << ", slew " << a.slew << "/s, deadband " << a.deadband;
+        for (const auto& [pose, gain] : a.gains)
+            out << (gain < 0 ? " - " : " + ") << std::abs(gain) << "·" << pose;
+        out << (a.invert ? ", inverted" : "") << "; limits " << a.min << " .. " << a.max
+            << ", rest " << a.rest << ", slew " << a.slew << "/s, deadband " << a.deadband;
         if (a.backend == Backend::Servo)
-            out << "\n    pulses " << a.pulseMinUs << " .. " << a.pulseMaxUs << " µs at " << a.frequencyHz
-                << " Hz, relax after " << a.idleAfter << " s at rest";
+            out << "\n    pulses " << a.pulseMinUs << " .. " << a.pulseMaxUs << " µs at "
+                << a.frequencyHz << " Hz, relax after " << a.idleAfter << " s at rest";
         if (a.backend == Backend::Switch)
-            out << "\n    on above " << a.threshold + a.hysteresis / 2 << ", off below " << a.threshold - a.hysteresis / 2
-                << ", at least " << a.minOnSeconds << " s on / " << a.minOffSeconds << " s off";
+            out << "\n    on above " << a.threshold + a.hysteresis / 2 << ", off below "
+                << a.threshold - a.hysteresis / 2 << ", at least " << a.minOnSeconds << " s on / "
+                << a.minOffSeconds << " s off";
         out << '\n';
     }
     for (const auto& h : hidDevices)
-        out << "  hid '" << h.name << "': " << (h.path.empty() ? "" : h.path + " ") << std::hex << std::setfill('0')
-            << std::setw(4) << h.vid << ':' << std::setw(4) << h.pid << std::dec << std::setfill(' ') << ", report id "
-            << int(h.reportId) << ", " << h.reportSize << " bytes, " << (h.encoding == HidEncoding::U8 ? "u8" : "u16le")
+        out << "  hid '" << h.name << "': " << (h.path.empty() ? "" : h.path + " ") << std::hex
+            << std::setfill('0') << std::setw(4) << h.vid << ':' << std::setw(4) << h.pid
+            << std::dec << std::setfill(' ') << ", report id " << int(h.reportId) << ", "
+            << h.reportSize << " bytes, " << (h.encoding == HidEncoding::U8 ? "u8" : "u16le")
             << ", " << h.rateHz << " Hz\n";
 }
 

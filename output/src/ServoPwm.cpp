@@ -3,8 +3,6 @@
 // TIMER_ABSTIME on CLOCK_MONOTONIC) so errors do not accumulate; the thread asks for SCHED_FIFO
 // and carries on at normal priority where that is not permitted. Pulse widths are atomics: the
 // control side never blocks the pulse loop.
-#include <lipsyncd/output.hpp>
-
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -13,6 +11,7 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <lipsyncd/output.hpp>
 
 namespace lipsyncd::output {
 
@@ -39,14 +38,17 @@ void sleepUntilNs(std::int64_t deadline) {
 }
 }  // namespace
 
-double ServoPwm::pulseUs(double value, double min, double max, double pulseMinUs, double pulseMaxUs) {
+double ServoPwm::pulseUs(double value, double min, double max, double pulseMinUs,
+                         double pulseMaxUs) {
     const double share = std::clamp((value - min) / (max - min), 0.0, 1.0);
     return pulseMinUs + share * (pulseMaxUs - pulseMinUs);
 }
 
 ServoPwm::ServoPwm(std::vector<Servo> servos, double frequencyHz, Clock clock, SleepUntil sleep)
-    : servos_(std::move(servos)), pulseNs_(servos_.size()),
-      periodNs_(static_cast<std::int64_t>(1e9 / frequencyHz)), clock_(clock ? std::move(clock) : monotonicNs),
+    : servos_(std::move(servos)),
+      pulseNs_(servos_.size()),
+      periodNs_(static_cast<std::int64_t>(1e9 / frequencyHz)),
+      clock_(clock ? std::move(clock) : monotonicNs),
       sleep_(sleep ? std::move(sleep) : sleepUntilNs) {
     for (auto& p : pulseNs_) p = 0;  // relaxed until told otherwise
 }
@@ -60,7 +62,8 @@ ServoPwm::~ServoPwm() {
 void ServoPwm::set(std::size_t servo, double value, bool active) {
     const auto& s = servos_[servo];
     const double us = pulseUs(value, s.min, s.max, s.pulseMinUs, s.pulseMaxUs);
-    pulseNs_[servo].store(active ? static_cast<std::int64_t>(us * 1000) : 0, std::memory_order_relaxed);
+    pulseNs_[servo].store(active ? static_cast<std::int64_t>(us * 1000) : 0,
+                          std::memory_order_relaxed);
 }
 
 void ServoPwm::period(std::int64_t start) {
@@ -101,7 +104,8 @@ void ServoPwm::start() {
             period(start);
             start += periodNs_;
             const auto now = clock_();
-            if (now > start + periodNs_) start = now;  // fell far behind (suspend): resync, no burst
+            if (now > start + periodNs_)
+                start = now;  // fell far behind (suspend): resync, no burst
             sleep_(start);
         }
     });

@@ -30,12 +30,14 @@ const fs::path& exampleWav() {
 TEST(LipsyncCli, HelpListsEveryCommandAndExitsZero) {
     const auto r = runLipsync({"--help"});
     EXPECT_EQ(r.exitCode, 0);
-    for (const char* cmd : {"analyze", "eval", "train", "calibrate", "say", "animate", "curves", "plot", "drive", "check", "devices"})
+    for (const char* cmd : {"analyze", "eval", "train", "calibrate", "say", "animate", "curves",
+                            "plot", "drive", "check", "devices"})
         EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd;
 }
 
 TEST(LipsyncCli, EachCommandHasHelp) {
-    for (const char* cmd : {"analyze", "eval", "train", "calibrate", "say", "animate", "curves", "plot", "drive", "check", "devices"}) {
+    for (const char* cmd : {"analyze", "eval", "train", "calibrate", "say", "animate", "curves",
+                            "plot", "drive", "check", "devices"}) {
         const auto r = runLipsync({cmd, "--help"});
         EXPECT_EQ(r.exitCode, 0) << cmd;
         EXPECT_NE(r.out.find("Usage"), std::string::npos) << cmd;

@@ -1,28 +1,30 @@
 // `lipsync animate`, `say --weights`, `analyze --weights` and `curves generate` as a user runs
 // them, and the golden replays (tests/golden, regenerated only by scripts/regen-golden.sh).
-#include "RunLipsync.hpp"
-
-#include <lipsyncd/core.hpp>
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
+#include <lipsyncd/core.hpp>
+
+#include "RunLipsync.hpp"
 
 namespace lipsyncd::test {
 namespace {
 
 namespace fs = std::filesystem;
 
-void expectSameTrack(const PoseTrack& a, const PoseTrack& b, float tolerance, const std::string& what) {
+void expectSameTrack(const PoseTrack& a, const PoseTrack& b, float tolerance,
+                     const std::string& what) {
     ASSERT_EQ(a.poses, b.poses) << what;
     ASSERT_EQ(a.frames(), b.frames()) << what;
     for (std::size_t i = 0; i < a.values.size(); ++i)
-        ASSERT_NEAR(a.values[i], b.values[i], tolerance) << what << ": frame " << i / a.poses.size();
+        ASSERT_NEAR(a.values[i], b.values[i], tolerance)
+            << what << ": frame " << i / a.poses.size();
 }
 
 TEST(GoldenReplay, SayProducesTheCommittedWeights) {
-    std::ifstream list(fs::path(LIPSYNCD_TEST_DATA_DIR).parent_path() / "golden" / "utterances.txt");
+    std::ifstream list(fs::path(LIPSYNCD_TEST_DATA_DIR).parent_path() / "golden" /
+                       "utterances.txt");
     ASSERT_TRUE(list) << "tests/golden/utterances.txt missing";
     const auto dir = scratchDir("golden");
     int replays = 0;
@@ -31,9 +33,11 @@ TEST(GoldenReplay, SayProducesTheCommittedWeights) {
         const auto a = line.find('|'), b = line.find('|', a + 1);
         const auto name = line.substr(0, a);
         const auto out = dir / (name + ".csv");
-        const auto r = runLipsync({"say", line.substr(b + 1), "--voice", line.substr(a + 1, b - a - 1), "--weights", out.string()});
+        const auto r = runLipsync({"say", line.substr(b + 1), "--voice",
+                                   line.substr(a + 1, b - a - 1), "--weights", out.string()});
         ASSERT_EQ(r.exitCode, 0) << r.err;
-        const auto golden = fs::path(LIPSYNCD_TEST_DATA_DIR).parent_path() / "golden" / (name + ".csv");
+        const auto golden =
+            fs::path(LIPSYNCD_TEST_DATA_DIR).parent_path() / "golden" / (name + ".csv");
         expectSameTrack(readPoseTrackCsvFile(out), readPoseTrackCsvFile(golden), 2e-4f,
                         name + " (if the change is meant, run scripts/regen-golden.sh)");
         ++replays;
@@ -43,11 +47,14 @@ TEST(GoldenReplay, SayProducesTheCommittedWeights) {
 
 TEST(AnimateCli, ArpabetLabelsAndStreamingMatchTheOfflinePass) {
     const auto dir = scratchDir("animate");
-    std::ofstream(dir / "hi.lab") << "0 0.2 sil\n0.2 0.3 HH\n0.3 0.5 AY1\n0.5 0.62 B\n0.62 0.9 AA1\n0.9 1.2 sil\n";
+    std::ofstream(dir / "hi.lab")
+        << "0 0.2 sil\n0.2 0.3 HH\n0.3 0.5 AY1\n0.5 0.62 B\n0.62 0.9 AA1\n0.9 1.2 sil\n";
     const auto offline = dir / "offline.csv", streamed = dir / "streamed.csv";
-    auto r = runLipsync({"animate", "--schedule", (dir / "hi.lab").string(), "--weights", offline.string()});
+    auto r = runLipsync(
+        {"animate", "--schedule", (dir / "hi.lab").string(), "--weights", offline.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    r = runLipsync({"animate", "--schedule", (dir / "hi.lab").string(), "--weights", streamed.string(), "--delay", "1.5"});
+    r = runLipsync({"animate", "--schedule", (dir / "hi.lab").string(), "--weights",
+                    streamed.string(), "--delay", "1.5"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto track = readPoseTrackCsvFile(offline);
     expectSameTrack(track, readPoseTrackCsvFile(streamed), 0, "streaming with a long delay");
@@ -59,15 +66,18 @@ TEST(AnimateCli, ArpabetLabelsAndStreamingMatchTheOfflinePass) {
 TEST(AnimateCli, BadSchedulesNameTheLineOrSymbol) {
     const auto dir = scratchDir("animate_bad");
     std::ofstream(dir / "overlap.tsv") << "0\t0.2\tsil\n0.1\t0.3\taa\n";
-    auto r = runLipsync({"animate", "--schedule", (dir / "overlap.tsv").string(), "--weights", "-"});
+    auto r =
+        runLipsync({"animate", "--schedule", (dir / "overlap.tsv").string(), "--weights", "-"});
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.err.find("overlap.tsv:2"), std::string::npos) << r.err;
     std::ofstream(dir / "unknown.tsv") << "0\t0.2\tsil\n0.2\t0.3\tqq\n";
     // An unknown symbol is a warning naming it and the line; the rest still animates.
-    r = runLipsync({"animate", "--schedule", (dir / "unknown.tsv").string(), "--labels", "common", "--weights", "-"});
+    r = runLipsync({"animate", "--schedule", (dir / "unknown.tsv").string(), "--labels", "common",
+                    "--weights", "-"});
     EXPECT_EQ(r.exitCode, 0);
     EXPECT_NE(r.err.find("unknown.tsv:2: unknown phoneme 'qq'"), std::string::npos) << r.err;
-    r = runLipsync({"animate", "--schedule", (dir / "unknown.tsv").string(), "--weights", "-", "--curves", "/nonexistent.json"});
+    r = runLipsync({"animate", "--schedule", (dir / "unknown.tsv").string(), "--weights", "-",
+                    "--curves", "/nonexistent.json"});
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.err.find("/nonexistent.json"), std::string::npos) << r.err;
 }
@@ -81,7 +91,8 @@ TEST(AnimateCli, AnalyzeGoesStraightFromAudioToWeights) {
     const auto track = readPoseTrackCsvFile(weights);
     ASSERT_GT(track.frames(), 50u);
     float maxOpen = 0;
-    for (std::size_t f = 0; f < track.frames(); ++f) maxOpen = std::max(maxOpen, track.frame(f)[*track.pose("open")]);
+    for (std::size_t f = 0; f < track.frames(); ++f)
+        maxOpen = std::max(maxOpen, track.frame(f)[*track.pose("open")]);
     EXPECT_GT(maxOpen, 0.3f);
     EXPECT_EQ(runLipsync({"analyze", wav.string()}).exitCode, 2);  // nothing to write
 }
@@ -95,16 +106,21 @@ std::size_t count(const std::string& text, const std::string& what) {
 TEST(PlotCli, DrawsACurvePerPoseAndThePhonemesUnderThem) {
     const auto dir = scratchDir("plot");
     const auto weights = dir / "w.csv", schedule = dir / "s.tsv", svg = dir / "w.svg";
-    ASSERT_EQ(runLipsync({"say", "Bob & me", "--weights", weights.string(), "--schedule", schedule.string()}).exitCode, 0);
-    const auto r = runLipsync({"plot", "--weights", weights.string(), "--schedule", schedule.string(), "-o", svg.string()});
+    ASSERT_EQ(runLipsync({"say", "Bob & me", "--weights", weights.string(), "--schedule",
+                          schedule.string()})
+                  .exitCode,
+              0);
+    const auto r = runLipsync({"plot", "--weights", weights.string(), "--schedule",
+                               schedule.string(), "-o", svg.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto text = slurp(svg);
     EXPECT_EQ(text.rfind("<?xml", 0), 0u);
     EXPECT_NE(text.find("</svg>"), std::string::npos);
     EXPECT_EQ(count(text, "<polyline class=\"pose\""), 9u);  // the FaceFX-style poses
     EXPECT_NE(text.find("data-pose=\"pbm\""), std::string::npos);
-    EXPECT_EQ(count(text, "<text x=") - count(text, " s</text>") - 3 /* axis values */ - 9 /* legend */,
-              readScheduleFile(schedule).size());
+    EXPECT_EQ(
+        count(text, "<text x=") - count(text, " s</text>") - 3 /* axis values */ - 9 /* legend */,
+        readScheduleFile(schedule).size());
     // Bad input names the file.
     std::ofstream(dir / "bad.csv") << "time,open\n0,0.1\n0.01\n";
     const auto bad = runLipsync({"plot", "--weights", (dir / "bad.csv").string(), "-o", "-"});

@@ -1,8 +1,7 @@
-#include <lipsyncd/core.hpp>
-
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <lipsyncd/core.hpp>
 
 using namespace lipsyncd;
 
@@ -10,8 +9,8 @@ TEST(PhonemeSet, CommonSetHasTwentyOneClassesPlusSilence) {
     const auto& set = PhonemeSet::common();
     EXPECT_EQ(set.size(), 22u);
     EXPECT_EQ(set[set.silence()].name, "sil");
-    for (const char* name : {"ah", "aa", "ao", "eh", "er", "ih", "w", "ow", "aw", "oy", "ay", "h",
-                             "r", "l", "z", "sh", "th", "f", "d", "kg", "bmp"})
+    for (const char* name : {"ah", "aa", "ao", "eh", "er", "ih", "w", "ow", "aw", "oy", "ay",
+                             "h",  "r",  "l",  "z",  "sh", "th", "f", "d",  "kg", "bmp"})
         EXPECT_TRUE(set.find(name).has_value()) << name;
     EXPECT_TRUE(set[*set.find("aa")].vowel);
     EXPECT_FALSE(set[*set.find("bmp")].vowel);
@@ -57,9 +56,10 @@ TEST(PhonemeMap, EnglishIpaCoversTheFortyPhonemesLikeArpabet) {
     const auto arpabet = PhonemeMap::named("arpabet");
     // The same sounds land in the same classes whichever alphabet names them.
     const std::pair<const char*, const char*> same[] = {
-        {"æ", "AE"}, {"ɑ", "AA"}, {"ɔ", "AO"}, {"eɪ", "EY"}, {"ɝ", "ER"}, {"iː", "IY"}, {"uː", "UW"},
-        {"oʊ", "OW"}, {"aʊ", "AW"}, {"ɔɪ", "OY"}, {"aɪ", "AY"}, {"h", "HH"}, {"ɹ", "R"}, {"ʃ", "SH"},
-        {"tʃ", "CH"}, {"ð", "DH"}, {"v", "V"}, {"ŋ", "NG"}, {"ɡ", "G"}, {"m", "M"}};
+        {"æ", "AE"},  {"ɑ", "AA"},  {"ɔ", "AO"},  {"eɪ", "EY"}, {"ɝ", "ER"},
+        {"iː", "IY"}, {"uː", "UW"}, {"oʊ", "OW"}, {"aʊ", "AW"}, {"ɔɪ", "OY"},
+        {"aɪ", "AY"}, {"h", "HH"},  {"ɹ", "R"},   {"ʃ", "SH"},  {"tʃ", "CH"},
+        {"ð", "DH"},  {"v", "V"},   {"ŋ", "NG"},  {"ɡ", "G"},   {"m", "M"}};
     for (const auto& [i, a] : same) {
         ASSERT_TRUE(ipa.map(i)) << i;
         EXPECT_EQ(ipa.map(i)->phoneme, arpabet.map(a)->phoneme) << i << " vs " << a;

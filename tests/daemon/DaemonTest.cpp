@@ -1,11 +1,6 @@
 // lipsyncd as systemd runs it: a subprocess with a test NOTIFY_SOCKET, the null or file audio
 // device and the recorder, driven over its control socket.
-#include "../cli/RunLipsync.hpp"
-
-#include <lipsyncd/core.hpp>
-
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -14,10 +9,14 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <fstream>
+#include <lipsyncd/core.hpp>
+#include <nlohmann/json.hpp>
 #include <thread>
+
+#include "../cli/RunLipsync.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -28,7 +27,7 @@ using namespace std::chrono_literals;
 
 // A datagram socket standing in for systemd's notification socket.
 class NotifySocket {
-public:
+  public:
     explicit NotifySocket(const fs::path& path) : path_(path) {
         fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
         sockaddr_un a{};
@@ -54,13 +53,13 @@ public:
     }
     std::vector<std::string> received;
 
-private:
+  private:
     fs::path path_;
     int fd_;
 };
 
 class Client {
-public:
+  public:
     explicit Client(const fs::path& path) {
         for (int i = 0; i < 100 && fd_ < 0; ++i) {
             fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
@@ -77,7 +76,9 @@ public:
         if (fd_ >= 0) ::close(fd_);
     }
     bool connected() const { return fd_ >= 0; }
-    void sendLine(const std::string& line) { ::send(fd_, (line + "\n").data(), line.size() + 1, MSG_NOSIGNAL); }
+    void sendLine(const std::string& line) {
+        ::send(fd_, (line + "\n").data(), line.size() + 1, MSG_NOSIGNAL);
+    }
     std::string readLine() {
         for (;;) {
             const auto nl = buf_.find('\n');
@@ -97,7 +98,7 @@ public:
         return json::parse(readLine());
     }
 
-private:
+  private:
     int fd_ = -1;
     std::string buf_;
 };
@@ -107,20 +108,22 @@ struct DaemonProcess {
     pid_t pid = -1;
 
     explicit DaemonProcess(const std::string& extraMouth = "", const std::string& device = "null") {
-        std::ofstream(dir / "lipsyncd.toml") << "[audio]\ndevice = \"" << device << "\"\n[mouth]\npuppet = \"terminal\"\n"
-                                              << "hardware = false\nrecord = \"" << (dir / "rec.csv").string() << "\"\n"
-                                              << extraMouth << "[control]\nsocket = \"" << (dir / "control.sock").string()
-                                              << "\"\n";
+        std::ofstream(dir / "lipsyncd.toml")
+            << "[audio]\ndevice = \"" << device << "\"\n[mouth]\npuppet = \"terminal\"\n"
+            << "hardware = false\nrecord = \"" << (dir / "rec.csv").string() << "\"\n"
+            << extraMouth << "[control]\nsocket = \"" << (dir / "control.sock").string() << "\"\n";
     }
     void start() {
         ::setenv("NOTIFY_SOCKET", (dir / "notify").c_str(), 1);
-        std::vector<std::string> args{LIPSYNCD_DAEMON_BIN, "--config", (dir / "lipsyncd.toml").string()};
+        std::vector<std::string> args{LIPSYNCD_DAEMON_BIN, "--config",
+                                      (dir / "lipsyncd.toml").string()};
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
         argv.push_back(nullptr);
         posix_spawn_file_actions_t actions;
         posix_spawn_file_actions_init(&actions);
-        posix_spawn_file_actions_addopen(&actions, 2, (dir / "stderr.log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        posix_spawn_file_actions_addopen(&actions, 2, (dir / "stderr.log").c_str(),
+                                         O_WRONLY | O_CREAT | O_TRUNC, 0644);
         ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
         posix_spawn_file_actions_destroy(&actions);
         ::unsetenv("NOTIFY_SOCKET");
@@ -149,7 +152,9 @@ struct DaemonProcess {
         std::getline(in, line);
         while (std::getline(in, line)) {
             const auto a = line.find(','), b = line.find(',', a + 1), c = line.find(',', b + 1);
-            if (line.substr(a + 1, b - a - 1) == actuator) out.emplace_back(std::stod(line.substr(0, a)), std::stod(line.substr(b + 1, c - b - 1)));
+            if (line.substr(a + 1, b - a - 1) == actuator)
+                out.emplace_back(std::stod(line.substr(0, a)),
+                                 std::stod(line.substr(b + 1, c - b - 1)));
         }
         return out;
     }
@@ -195,7 +200,8 @@ TEST(Daemon, NotifiesSystemdReloadsOnSighupAndRestsOnSigterm) {
 
 TEST(Daemon, MalformedConfigStopsStartupWithTheLine) {
     const auto dir = scratchDir("daemon_badconf");
-    std::ofstream(dir / "bad.toml") << "[audio]\ndevice = \"null\"\n[mouth]\npupet = \"terminal\"\n";
+    std::ofstream(dir / "bad.toml")
+        << "[audio]\ndevice = \"null\"\n[mouth]\npupet = \"terminal\"\n";
     const auto r = runProgram(LIPSYNCD_DAEMON_BIN, {"--config", (dir / "bad.toml").string()});
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.err.find("bad.toml:4"), std::string::npos) << r.err;
@@ -215,16 +221,21 @@ TEST(Daemon, PlayedFileDrivesTheMouthAsTheOfflinePassDoes) {
     // Offline: the same audio, analysed and driven through the same puppet.
     const auto off = d.dir / "offline";
     fs::create_directories(off);
-    ASSERT_EQ(runLipsync({"analyze", example.string(), "--weights", (off / "w.csv").string(), "-q"}).exitCode, 0);
-    ASSERT_EQ(runLipsync({"drive", "--weights", (off / "w.csv").string(), "--puppet", "terminal", "--no-hardware",
-                          "--record", (off / "rec.csv").string()}).exitCode, 0);
+    ASSERT_EQ(runLipsync({"analyze", example.string(), "--weights", (off / "w.csv").string(), "-q"})
+                  .exitCode,
+              0);
+    ASSERT_EQ(runLipsync({"drive", "--weights", (off / "w.csv").string(), "--puppet", "terminal",
+                          "--no-hardware", "--record", (off / "rec.csv").string()})
+                  .exitCode,
+              0);
     std::vector<double> offline;
     {
         std::ifstream in(off / "rec.csv");
         std::string line;
         std::getline(in, line);
         while (std::getline(in, line))
-            if (line.find(",jaw,") != std::string::npos) offline.push_back(std::stod(line.substr(line.find(",jaw,") + 5)));
+            if (line.find(",jaw,") != std::string::npos)
+                offline.push_back(std::stod(line.substr(line.find(",jaw,") + 5)));
     }
     // The daemon's jaw while the clip played, resampled onto 10 ms steps from its first movement.
     const auto live = d.recorded("jaw");
@@ -270,11 +281,21 @@ TEST(Daemon, ManyClientsAndMalformedRequestsLoseNothingAndMemoryStaysFlat) {
             for (int i = 0; i < 80; ++i) {
                 std::string line;
                 switch ((i + t) % 5) {
-                    case 0: line = R"({"cmd":"status"})"; break;
-                    case 1: line = "{broken json"; break;
-                    case 2: line = R"({"cmd":"frobnicate"})"; break;
-                    case 3: line = R"({"cmd":"play","file":"/nonexistent.wav"})"; break;
-                    default: line = R"([1,2,3])"; break;
+                    case 0:
+                        line = R"({"cmd":"status"})";
+                        break;
+                    case 1:
+                        line = "{broken json";
+                        break;
+                    case 2:
+                        line = R"({"cmd":"frobnicate"})";
+                        break;
+                    case 3:
+                        line = R"({"cmd":"play","file":"/nonexistent.wav"})";
+                        break;
+                    default:
+                        line = R"([1,2,3])";
+                        break;
                 }
                 c.sendLine(line);
                 const auto reply = c.readLine();
@@ -299,19 +320,25 @@ TEST(Daemon, ManyClientsAndMalformedRequestsLoseNothingAndMemoryStaysFlat) {
 // 16-bit mono WAV: `silence` seconds, then a 120 Hz buzz (a voiced sound) for `sound` seconds.
 void writeOnsetWav(const fs::path& path, double silence, double sound, int rate = 16000) {
     std::vector<std::int16_t> pcm(static_cast<std::size_t>((silence + sound + 1.0) * rate), 0);
-    const auto from = static_cast<std::size_t>(silence * rate), to = static_cast<std::size_t>((silence + sound) * rate);
+    const auto from = static_cast<std::size_t>(silence * rate),
+               to = static_cast<std::size_t>((silence + sound) * rate);
     for (std::size_t i = from; i < to; ++i) {
         double v = 0;
-        for (int h = 1; h <= 20; ++h) v += std::sin(2 * M_PI * 120 * h * static_cast<double>(i) / rate) / h * (h == 6 || h == 10 ? 3 : 1);
+        for (int h = 1; h <= 20; ++h)
+            v += std::sin(2 * M_PI * 120 * h * static_cast<double>(i) / rate) / h *
+                 (h == 6 || h == 10 ? 3 : 1);
         pcm[i] = static_cast<std::int16_t>(std::clamp(v * 4000, -32000.0, 32000.0));
     }
     std::ofstream out(path, std::ios::binary);
-    const auto put = [&](std::uint32_t v, int bytes) { out.write(reinterpret_cast<const char*>(&v), bytes); };
+    const auto put = [&](std::uint32_t v, int bytes) {
+        out.write(reinterpret_cast<const char*>(&v), bytes);
+    };
     const auto data = static_cast<std::uint32_t>(pcm.size() * 2);
     out << "RIFF";
     put(36 + data, 4);
     out << "WAVEfmt ";
-    put(16, 4), put(1, 2), put(1, 2), put(static_cast<std::uint32_t>(rate), 4), put(static_cast<std::uint32_t>(rate * 2), 4), put(2, 2), put(16, 2);
+    put(16, 4), put(1, 2), put(1, 2), put(static_cast<std::uint32_t>(rate), 4),
+        put(static_cast<std::uint32_t>(rate * 2), 4), put(2, 2), put(16, 2);
     out << "data";
     put(data, 4);
     out.write(reinterpret_cast<const char*>(pcm.data()), data);
@@ -321,7 +348,8 @@ TEST(Daemon, LiveCaptureMovesTheMouthSoonAfterASoundStarts) {
     const auto dir = scratchDir("daemon_live");
     writeOnsetWav(dir / "onset.wav", 1.0, 0.6);
     DaemonProcess d("", "null");
-    std::ofstream(d.dir / "lipsyncd.toml", std::ios::app) << "[live]\ndevice = \"file:" << (dir / "onset.wav").string() << "\"\n";
+    std::ofstream(d.dir / "lipsyncd.toml", std::ios::app)
+        << "[live]\ndevice = \"file:" << (dir / "onset.wav").string() << "\"\n";
     d.start();
     Client c(d.dir / "control.sock");
     ASSERT_TRUE(c.connected());
@@ -342,8 +370,9 @@ TEST(Daemon, LiveCaptureMovesTheMouthSoonAfterASoundStarts) {
             }
     ASSERT_GT(first, 0) << "the mouth never moved on live input";
     const double latency = first - onset;
-    std::cout << "live latency (onset -> first actuator command): " << latency * 1000 << " ms (front end bound "
-              << on["front_end_latency"].get<double>() * 1000 << " ms)\n";
+    std::cout << "live latency (onset -> first actuator command): " << latency * 1000
+              << " ms (front end bound " << on["front_end_latency"].get<double>() * 1000
+              << " ms)\n";
     EXPECT_GT(latency, 0.0) << "moved before the sound";
     EXPECT_LT(latency, 0.6);
 }

@@ -1,12 +1,12 @@
 // Curve sets, character files and pose sets as data: the shipped ones load and are reproducible;
 // malformed ones are refused with the bigram, pose or line at fault.
-#include "RuntimeTestSupport.hpp"
-
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "RuntimeTestSupport.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -14,7 +14,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path writeTemp(const std::string& name, const std::string& text) {
-    const auto path = fs::temp_directory_path() / ("lipsyncd_" + std::to_string(::getpid()) + "_" + name);
+    const auto path =
+        fs::temp_directory_path() / ("lipsyncd_" + std::to_string(::getpid()) + "_" + name);
     std::ofstream(path) << text;
     return path;
 }
@@ -37,7 +38,8 @@ std::string errorLoading(const std::string& json) {
     return "no error";
 }
 
-const std::string kHead = R"({"format": "lipsyncd-curves", "version": 1, "name": "bad", "pose_set": "facefx", "bigrams": )";
+const std::string kHead =
+    R"({"format": "lipsyncd-curves", "version": 1, "name": "bad", "pose_set": "facefx", "bigrams": )";
 
 TEST(CurveFiles, TheShippedSetCoversEveryPair) {
     const auto poses = lipsync::PoseSet::named("facefx");
@@ -53,12 +55,14 @@ TEST(CurveFiles, TheShippedSetCoversEveryPair) {
 TEST(CurveFiles, RegeneratingTheShippedSetGivesTheCommittedFile) {
     const auto poses = lipsync::PoseSet::named("facefx");
     const auto set = lipsync::generateCurveSet(findDataFile("curves/english-rules.toml"), poses);
-    const auto out = fs::temp_directory_path() / ("lipsyncd_english_" + std::to_string(::getpid()) + ".json");
+    const auto out =
+        fs::temp_directory_path() / ("lipsyncd_english_" + std::to_string(::getpid()) + ".json");
     set.save(out, poses, PhonemeSet::common());
     EXPECT_EQ(slurp(out), slurp(findDataFile("curves/english.json")))
         << "config/curves/english.json is stale: run scripts/make-curves.sh";
     const auto& mandarin = PhonemeSet::named("mandarin");
-    const auto additions = lipsync::generateCurveSet(findDataFile("curves/mandarin-rules.toml"), poses, mandarin);
+    const auto additions =
+        lipsync::generateCurveSet(findDataFile("curves/mandarin-rules.toml"), poses, mandarin);
     additions.saveAdditions(out, "english", *mandarin.find("yu"), poses, mandarin);
     EXPECT_EQ(slurp(out), slurp(findDataFile("curves/mandarin.json")))
         << "config/curves/mandarin.json is stale: run scripts/make-curves.sh";
@@ -76,10 +80,12 @@ TEST(CurveFiles, MandarinAddsOneClassWithItsPairsOnTopOfEnglish) {
     const auto w = *poses.find("w");
     ASSERT_NE(set.curve(*mandarin.find("d"), yu, w), nullptr);  // a new pair: ü rounds the lips
     EXPECT_GT(set.curve(*mandarin.find("d"), yu, w)->at(0.75), 0.7f);
-    const auto* mine = set.curve(cls("ow"), cls("bmp"), *poses.find("pbm"));  // an English pair, reused
+    const auto* mine =
+        set.curve(cls("ow"), cls("bmp"), *poses.find("pbm"));  // an English pair, reused
     const auto* theirs = english.curve(cls("ow"), cls("bmp"), *poses.find("pbm"));
     ASSERT_TRUE(mine && theirs);
-    EXPECT_TRUE(std::equal(mine->polygon().begin(), mine->polygon().end(), theirs->polygon().begin(), theirs->polygon().end()));
+    EXPECT_TRUE(std::equal(mine->polygon().begin(), mine->polygon().end(),
+                           theirs->polygon().begin(), theirs->polygon().end()));
     // The additions file holds exactly the 2·23 − 1 = 45 pairs that involve ü.
     const auto text = slurp(findDataFile("curves/mandarin.json"));
     std::size_t pairs = 0;
@@ -100,7 +106,8 @@ TEST(CurveFiles, MandarinAddsOneClassWithItsPairsOnTopOfEnglish) {
 }
 
 TEST(CurveFiles, ErrorsNameTheBigramAndPose) {
-    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"jaw": [[0,0],[1,0]]}}})").find("bigrams.aa-bmp.jaw: unknown pose"),
+    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"jaw": [[0,0],[1,0]]}}})")
+                  .find("bigrams.aa-bmp.jaw: unknown pose"),
               std::string::npos);
     EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"open": [[0,0],[0.6,0.2],[0.5,0.1],[1,0]]}}})")
                   .find("bigrams.aa-bmp.open[2]: times must increase"),
@@ -108,19 +115,24 @@ TEST(CurveFiles, ErrorsNameTheBigramAndPose) {
     EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"open": [[0,0],[0.5,1.5],[1,0]]}}})")
                   .find("bigrams.aa-bmp.open[1]: value must be in [0, 1]"),
               std::string::npos);
-    EXPECT_NE(errorLoading(kHead + R"({"aa-zz": {}}})").find("bigrams.aa-zz: not a pair"), std::string::npos);
-    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {}}})").find("missing pair 'sil-sil'"), std::string::npos);
-    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"open": [[0.1,0],[1,0]]}}})").find("from time 0 to time 1"),
+    EXPECT_NE(errorLoading(kHead + R"({"aa-zz": {}}})").find("bigrams.aa-zz: not a pair"),
               std::string::npos);
-    EXPECT_NE(errorLoading(R"({"format": "lipsyncd-curves", "version": 2, "name": "x"})").find("version"),
+    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {}}})").find("missing pair 'sil-sil'"),
               std::string::npos);
+    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"open": [[0.1,0],[1,0]]}}})")
+                  .find("from time 0 to time 1"),
+              std::string::npos);
+    EXPECT_NE(
+        errorLoading(R"({"format": "lipsyncd-curves", "version": 2, "name": "x"})").find("version"),
+        std::string::npos);
     EXPECT_NE(errorLoading("{").find("not valid JSON"), std::string::npos);
 }
 
 TEST(CurveFiles, ACharacterReplacesSingleBigramsOnly) {
     const auto poses = lipsync::PoseSet::named("facefx");
     const auto base = lipsync::BigramCurveSet::named("english", poses);
-    const auto path = writeTemp("crab.json", R"({"format": "lipsyncd-character", "version": 1, "name": "crab",
+    const auto path =
+        writeTemp("crab.json", R"({"format": "lipsyncd-character", "version": 1, "name": "crab",
         "base": "english", "pose_set": "facefx",
         "bigrams": {"aa-bmp": {"w": [[0,0],[0.5,1],[1,0]]}}})");
     const auto crab = lipsync::BigramCurveSet::load(path, poses);
@@ -132,8 +144,8 @@ TEST(CurveFiles, ACharacterReplacesSingleBigramsOnly) {
     const auto* mine = crab.curve(cls("ow"), cls("bmp"), pbm);
     const auto* theirs = base.curve(cls("ow"), cls("bmp"), pbm);
     ASSERT_TRUE(mine && theirs);
-    EXPECT_TRUE(std::equal(mine->polygon().begin(), mine->polygon().end(), theirs->polygon().begin(),
-                           theirs->polygon().end()));
+    EXPECT_TRUE(std::equal(mine->polygon().begin(), mine->polygon().end(),
+                           theirs->polygon().begin(), theirs->polygon().end()));
 }
 
 TEST(PoseSetFiles, MistakesNameTheLine) {
@@ -145,13 +157,17 @@ TEST(PoseSetFiles, MistakesNameTheLine) {
         }
         return std::string("no error");
     };
-    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\nspeed = 3\n").find(":4:"), std::string::npos);
-    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\n[[pose]]\nname = \"open\"\n").find("defined twice"),
+    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\nspeed = 3\n").find(":4:"),
               std::string::npos);
-    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\n[[constraint]]\nposes = [\"open\", \"jaw\"]\nthreshold = 0.5\n")
+    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\n[[pose]]\nname = \"open\"\n")
+                  .find("defined twice"),
+              std::string::npos);
+    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\n[[constraint]]\nposes = [\"open\", "
+                      "\"jaw\"]\nthreshold = 0.5\n")
                   .find("unknown pose 'jaw'"),
               std::string::npos);
-    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\nspeed_limit = -1\n").find("greater than 0"),
+    EXPECT_NE(errorOf("name = \"x\"\n[[pose]]\nname = \"open\"\nspeed_limit = -1\n")
+                  .find("greater than 0"),
               std::string::npos);
 }
 

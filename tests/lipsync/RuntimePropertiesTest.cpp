@@ -1,10 +1,10 @@
 // The whole runtime over random schedules: what must hold whatever the input, and streaming
 // against the offline pass.
-#include "RuntimeTestSupport.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
+
+#include "RuntimeTestSupport.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -33,14 +33,16 @@ PhonemeSchedule randomSchedule(std::mt19937& rng, std::size_t n, double start = 
     return s;
 }
 
-void expectBoundsSpeedAndConstraints(const PoseTrack& track, const lipsync::PoseSet& poses, double rate) {
+void expectBoundsSpeedAndConstraints(const PoseTrack& track, const lipsync::PoseSet& poses,
+                                     double rate) {
     for (std::size_t f = 0; f < track.frames(); ++f) {
         const auto w = track.frame(f);
         for (std::size_t p = 0; p < poses.size(); ++p) {
             ASSERT_GE(w[p], 0.0f);
             ASSERT_LE(w[p], 1.0f);
             const float before = f == 0 ? 0.0f : track.frame(f - 1)[p];
-            ASSERT_LE(std::abs(w[p] - before), poses[p].speedLimit / rate + 1e-5) << poses[p].name << " at " << f;
+            ASSERT_LE(std::abs(w[p] - before), poses[p].speedLimit / rate + 1e-5)
+                << poses[p].name << " at " << f;
         }
         for (const auto& c : poses.constraints())
             ASSERT_LE(w[c.low], std::max(0.0f, static_cast<float>(c.threshold) - w[c.high]) + 1e-5f)
@@ -53,7 +55,8 @@ TEST(RuntimeProperties, BoundsSpeedLimitsAndConstraintsHoldAfterTheLastStep) {
     for (int trial = 0; trial < 30; ++trial) {
         const auto s = randomSchedule(rng, 40);
         const auto track = lipsync::animate(s, shipped().curves, shipped().poses);
-        ASSERT_EQ(track.frames(), static_cast<std::size_t>(std::floor(s.back().end * 100 + 1e-9)) + 1);
+        ASSERT_EQ(track.frames(),
+                  static_cast<std::size_t>(std::floor(s.back().end * 100 + 1e-9)) + 1);
         expectBoundsSpeedAndConstraints(track, shipped().poses, 100);
     }
 }
@@ -67,7 +70,8 @@ TEST(RuntimeProperties, MaxStitchNeverLowersACurve) {
     // Each bigram alone (a two-phoneme schedule, not bracketed) is never above the stitched result.
     for (std::size_t i = 0; i + 1 < s.size(); ++i) {
         lipsync::PoseCurves one(shipped().poses.size(), 100, 0, 0, frames);
-        lipsync::stitchBigrams(std::span(s).subspan(i, 2), shipped().curves, PhonemeSet::common(), one, {false, false});
+        lipsync::stitchBigrams(std::span(s).subspan(i, 2), shipped().curves, PhonemeSet::common(),
+                               one, {false, false});
         for (std::size_t p = 0; p < one.values.size(); ++p)
             for (std::size_t f = 0; f < frames; ++f) ASSERT_GE(all.values[p][f], one.values[p][f]);
     }
@@ -75,8 +79,9 @@ TEST(RuntimeProperties, MaxStitchNeverLowersACurve) {
 
 TEST(RuntimeProperties, ShortLongAndSingleSchedulesBehave) {
     const auto& sh = shipped();
-    for (const PhonemeSchedule& s : {PhonemeSchedule{{0, 0.004, "aa", 1}}, PhonemeSchedule{{0, 12.0, "ow", 1}},
-                                     PhonemeSchedule{{0, 0.5, "sil", 1}, {0.5, 0.51, "bmp", 1}, {0.51, 1, "sil", 1}}}) {
+    for (const PhonemeSchedule& s :
+         {PhonemeSchedule{{0, 0.004, "aa", 1}}, PhonemeSchedule{{0, 12.0, "ow", 1}},
+          PhonemeSchedule{{0, 0.5, "sil", 1}, {0.5, 0.51, "bmp", 1}, {0.51, 1, "sil", 1}}}) {
         const auto track = lipsync::animate(s, sh.curves, sh.poses);
         ASSERT_GE(track.frames(), 1u);
         expectBoundsSpeedAndConstraints(track, sh.poses, 100);
@@ -85,8 +90,9 @@ TEST(RuntimeProperties, ShortLongAndSingleSchedulesBehave) {
             for (float v : track.frame(track.frames() - 1)) EXPECT_LT(v, 0.05f);
     }
     // A long vowel holds its pose rather than sagging in the middle.
-    const auto held = lipsync::animate(PhonemeSchedule{{0, 0.3, "sil", 1}, {0.3, 3.3, "aa", 1}, {3.3, 3.6, "sil", 1}},
-                                       sh.curves, sh.poses);
+    const auto held = lipsync::animate(
+        PhonemeSchedule{{0, 0.3, "sil", 1}, {0.3, 3.3, "aa", 1}, {3.3, 3.6, "sil", 1}}, sh.curves,
+        sh.poses);
     const auto open = *held.pose("open");
     EXPECT_GT(held.frame(180)[open], 0.45f);
 }
@@ -102,7 +108,8 @@ TEST(StreamingRuntime, WithALongEnoughDelayEqualsTheOfflinePass) {
         stream.finish(streamed);
         ASSERT_EQ(streamed.frames(), offline.frames());
         for (std::size_t i = 0; i < offline.values.size(); ++i)
-            ASSERT_FLOAT_EQ(streamed.values[i], offline.values[i]) << "frame " << i / offline.poses.size();
+            ASSERT_FLOAT_EQ(streamed.values[i], offline.values[i])
+                << "frame " << i / offline.poses.size();
     }
 }
 

@@ -1,7 +1,7 @@
 // Each step of the runtime (section 2.2) on hand-computed cases.
-#include "RuntimeTestSupport.hpp"
-
 #include <gtest/gtest.h>
+
+#include "RuntimeTestSupport.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -33,8 +33,8 @@ TEST(ControlCurve, StaysInsideTheControlValues) {
 TEST(Stitching, PairsSpanTwoPhonemesAndOverlapsKeepTheMax) {
     const auto poses = twoPoses();
     lipsync::BigramCurveSet set("t", poses, PhonemeSet::common());
-    set.setCurve(cls("sil"), cls("aa"), 0, flat(0.3f));  // covers aa
-    set.setCurve(cls("aa"), cls("bmp"), 0, flat(0.6f));  // covers aa and bmp
+    set.setCurve(cls("sil"), cls("aa"), 0, flat(0.3f));   // covers aa
+    set.setCurve(cls("aa"), cls("bmp"), 0, flat(0.6f));   // covers aa and bmp
     set.setCurve(cls("bmp"), cls("sil"), 0, flat(0.2f));  // covers bmp
     const PhonemeSchedule s{{0, 0.1, "aa", 1}, {0.1, 0.2, "bmp", 1}};
     PoseCurves curves(2, 100, 0, 0, 21);
@@ -73,7 +73,7 @@ TEST(Stitching, UnknownPhonemeIsNamed) {
 
 TEST(ValleySmoothing, FillsAValleyBetweenNearPeaks) {
     std::vector<float> c{0, 1, 0.2f, 0.2f, 0.8f, 0};
-    lipsync::smoothValleys(c, 100, 0.05);  // peaks 3 frames apart, window 5 frames
+    lipsync::smoothValleys(c, 100, 0.05);     // peaks 3 frames apart, window 5 frames
     EXPECT_FLOAT_EQ(c[2], 1 - 0.2f / 3 * 1);  // on the line from 1 (frame 1) to 0.8 (frame 4)
     EXPECT_FLOAT_EQ(c[3], 1 - 0.2f / 3 * 2);
     EXPECT_FLOAT_EQ(c[5], 0);

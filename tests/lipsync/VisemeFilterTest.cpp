@@ -1,7 +1,7 @@
 // The viseme-space filter runtime (paper 001, section 5).
-#include "RuntimeTestSupport.hpp"
-
 #include <gtest/gtest.h>
+
+#include "RuntimeTestSupport.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -14,12 +14,12 @@ TEST(VisemeFilter, WeightsFollowTheEquationOnAStep) {
     const auto track = lipsync::animateFilter(s, set, poses);
     ASSERT_EQ(track.frames(), 41u);
     const auto open = [&](std::size_t f) { return track.frame(f)[0]; };
-    EXPECT_FLOAT_EQ(open(6), 0.0f);               // slots 5..9 all silence
-    EXPECT_NEAR(open(7), 0.1 * 0.8, 1e-6);        // only a_{i+3} is aa: anticipation
+    EXPECT_FLOAT_EQ(open(6), 0.0f);         // slots 5..9 all silence
+    EXPECT_NEAR(open(7), 0.1 * 0.8, 1e-6);  // only a_{i+3} is aa: anticipation
     EXPECT_NEAR(open(9), (0.3 + 0.1) * 0.8, 1e-6);
     EXPECT_NEAR(open(10), (0.5 + 0.3 + 0.1) * 0.8, 1e-6);
-    EXPECT_NEAR(open(15), 0.8, 1e-6);             // inside: all weights on aa
-    EXPECT_NEAR(open(30), 0.1 * 0.8, 1e-6);       // the step down: only a_{i-1} is aa
+    EXPECT_NEAR(open(15), 0.8, 1e-6);        // inside: all weights on aa
+    EXPECT_NEAR(open(30), 0.1 * 0.8, 1e-6);  // the step down: only a_{i-1} is aa
 }
 
 TEST(VisemeFilter, AveragesSlotsDownToTheOutputRate) {

@@ -1,12 +1,12 @@
 // The safety layer: whatever comes in, commands stay within limits and slew; NaN holds;
 // switches do not chatter; the mouth rests on stop and on stalled input; idle servos relax.
-#include "OutputTestSupport.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <random>
+
+#include "OutputTestSupport.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -31,7 +31,9 @@ idle_after = 0.5
 
 struct Collect : output::CommandSink {
     std::vector<std::pair<double, output::ActuatorCommand>> seen;
-    void write(double t, std::span<const output::ActuatorCommand> c) override { seen.emplace_back(t, c[0]); }
+    void write(double t, std::span<const output::ActuatorCommand> c) override {
+        seen.emplace_back(t, c[0]);
+    }
 };
 
 TEST(ActuatorSafety, CommandsStayWithinLimitsAndSlewWhateverComesIn) {
@@ -41,10 +43,16 @@ TEST(ActuatorSafety, CommandsStayWithinLimitsAndSlewWhateverComesIn) {
     driver.addSink(sink);
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> any(-1e6f, 1e6f);
-    const float specials[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
-                              -std::numeric_limits<float>::infinity(), 1e30f, -1e30f, 0, 1};
+    const float specials[] = {std::numeric_limits<float>::quiet_NaN(),
+                              std::numeric_limits<float>::infinity(),
+                              -std::numeric_limits<float>::infinity(),
+                              1e30f,
+                              -1e30f,
+                              0,
+                              1};
     for (int i = 0; i < 5000; ++i) {
-        const float w[2] = {i % 7 == 0 ? specials[i % 7] : any(rng), i % 11 == 0 ? specials[(i / 11) % 7] : any(rng)};
+        const float w[2] = {i % 7 == 0 ? specials[i % 7] : any(rng),
+                            i % 11 == 0 ? specials[(i / 11) % 7] : any(rng)};
         driver.update(0.01 * i, w);
     }
     for (std::size_t i = 0; i < sink.seen.size(); ++i) {
@@ -114,7 +122,8 @@ TEST(ActuatorSafety, DeadbandKeepsSmallChangesFromTheActuator) {
     const double held = driver.last()[0].value;
     EXPECT_NEAR(held, 0.5, 0.02);  // within a deadband of the target
     // Jitter smaller than the deadband around where it stands: nothing moves.
-    const float up[2] = {static_cast<float>(held + 0.009), 0}, down[2] = {static_cast<float>(held - 0.009), 0};
+    const float up[2] = {static_cast<float>(held + 0.009), 0},
+                down[2] = {static_cast<float>(held - 0.009), 0};
     for (int i = 30; i < 60; ++i) driver.update(0.01 * i, i % 2 ? up : down);
     EXPECT_EQ(driver.last()[0].value, held);
     const float far[2] = {static_cast<float>(held + 0.1), 0};  // a real move goes through
@@ -132,10 +141,10 @@ TEST(SwitchLogic, HysteresisAndMinimumTimesPreventChatter) {
     output::SwitchLogic s(c);
     EXPECT_FALSE(s.update(0.00, 0.55));  // inside the band: stays off
     EXPECT_TRUE(s.update(0.01, 0.65));
-    EXPECT_TRUE(s.update(0.02, 0.1));    // on for 10 ms only: min_on holds it
-    EXPECT_TRUE(s.update(0.10, 0.45));   // inside the band
-    EXPECT_FALSE(s.update(0.11, 0.3));   // 100 ms served: off
-    EXPECT_FALSE(s.update(0.12, 0.9));   // off for 10 ms: min_off holds it
+    EXPECT_TRUE(s.update(0.02, 0.1));   // on for 10 ms only: min_on holds it
+    EXPECT_TRUE(s.update(0.10, 0.45));  // inside the band
+    EXPECT_FALSE(s.update(0.11, 0.3));  // 100 ms served: off
+    EXPECT_FALSE(s.update(0.12, 0.9));  // off for 10 ms: min_off holds it
     EXPECT_TRUE(s.update(0.16, 0.9));
     // Random input: no state lasts less than its minimum.
     std::mt19937 rng(2);

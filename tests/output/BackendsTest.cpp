@@ -1,10 +1,10 @@
 // The backends behind their seams: servo pulses on a fake line and clock, a HID board that
 // vanishes and comes back, the real libgpiod and hidapi paths up to the missing device.
-#include "OutputTestSupport.hpp"
-
 #include <gtest/gtest.h>
 
 #include <sstream>
+
+#include "OutputTestSupport.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -18,17 +18,18 @@ TEST(ServoPwm, PulseWidthsFollowTheValuesAndRelaxedServosGetNone) {
         lines.push_back(line.get());
         servos.push_back({std::move(line), 1000, 2000, 0.0, 1.0});
     }
-    output::ServoPwm pwm(std::move(servos), 50, [&] { return now; }, [&](std::int64_t t) { now = t; });
-    pwm.set(0, 0.25, true);   // 1250 µs
-    pwm.set(1, 0.9, false);   // relaxed
+    output::ServoPwm pwm(
+        std::move(servos), 50, [&] { return now; }, [&](std::int64_t t) { now = t; });
+    pwm.set(0, 0.25, true);  // 1250 µs
+    pwm.set(1, 0.9, false);  // relaxed
     pwm.runPeriods(3);
     const auto& e = lines[0]->edges;
     ASSERT_EQ(e.size(), 6u);
     for (int p = 0; p < 3; ++p) {
         EXPECT_TRUE(e[2 * p].second);
         EXPECT_FALSE(e[2 * p + 1].second);
-        EXPECT_EQ(e[2 * p + 1].first - e[2 * p].first, 1'250'000);        // the pulse
-        EXPECT_EQ(e[2 * p].first, e[0].first + p * 20'000'000LL);         // every 20 ms
+        EXPECT_EQ(e[2 * p + 1].first - e[2 * p].first, 1'250'000);  // the pulse
+        EXPECT_EQ(e[2 * p].first, e[0].first + p * 20'000'000LL);   // every 20 ms
     }
     EXPECT_TRUE(lines[1]->edges.empty());
     EXPECT_DOUBLE_EQ(output::ServoPwm::pulseUs(5, 0, 1, 1000, 2000), 2000);  // clamped
@@ -75,9 +76,9 @@ TEST(HidSink, ReportsCarryTheEncodedChannelsAtTheBoardRate) {
     EXPECT_EQ(board.reports.size(), 50u);
     ASSERT_EQ(board.reports[0].size(), 5u);  // report id + 4 bytes
     EXPECT_EQ(board.reports[0][0], 7);
-    EXPECT_EQ(board.reports[0][3], 0x00);    // channel 1, u16le, 1.0 of 0..2 → 32768 (0x8000)
+    EXPECT_EQ(board.reports[0][3], 0x00);  // channel 1, u16le, 1.0 of 0..2 → 32768 (0x8000)
     EXPECT_EQ(board.reports[0][4], 0x80);
-    EXPECT_EQ(board.reports[0][1], 0x00);    // channel 0 unused
+    EXPECT_EQ(board.reports[0][1], 0x00);  // channel 0 unused
 }
 
 TEST(HidSink, ABoardThatVanishesIsReopenedWhileOtherOutputsGoOn) {
@@ -102,8 +103,9 @@ TEST(HidSink, ABoardThatVanishesIsReopenedWhileOtherOutputsGoOn) {
         driver.update(0.01 * i, w);
     }
     const auto text = recorded.str();
-    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 2 * 300);  // the recorder never missed a step
-    EXPECT_GE(opens, 3);  // first open, retries while gone, the reopen
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'),
+              1 + 2 * 300);  // the recorder never missed a step
+    EXPECT_GE(opens, 3);     // first open, retries while gone, the reopen
     ASSERT_GE(log.size(), 2u);
     EXPECT_NE(log.front().find("gone"), std::string::npos);
     EXPECT_NE(log.back().find("back"), std::string::npos);
@@ -131,7 +133,8 @@ TEST(RealDevices, AnAbsentHidBoardIsNotAnError) {
 }
 
 TEST(PuppetFiles, TheShippedExamplesLoad) {
-    for (const char* name : {"jaw-servo", "jaw-and-lips", "pneumatic-jaw", "led-mouth", "hid-board", "terminal"}) {
+    for (const char* name :
+         {"jaw-servo", "jaw-and-lips", "pneumatic-jaw", "led-mouth", "hid-board", "terminal"}) {
         const auto p = output::Puppet::load(findDataFile(std::string("puppets/") + name + ".toml"));
         EXPECT_FALSE(p.actuators.empty()) << name;
     }
@@ -146,19 +149,26 @@ TEST(PuppetFiles, MistakesNameTheLine) {
         }
         return std::string("no error");
     };
-    const std::string jaw = "[[actuator]]\nname = \"jaw\"\nbackend = \"servo\"\nline = 18\ngains = { open = 1 }\n";
-    EXPECT_NE(errorOf(jaw + "min = 0\nmax = 1\nslwe = 3\n").find(":9: unknown key"), std::string::npos);  // unknown key
-    EXPECT_NE(errorOf(jaw + "min = \"0\"\nmax = 1\n").find(":7:"), std::string::npos);  // wrong type
-    EXPECT_NE(errorOf(jaw + "min = 0.8\nmax = 0.2\n").find("greater than min"), std::string::npos);       // min > max
-    EXPECT_NE(errorOf(jaw + "min = 0\nmax = 1\n" + "[[actuator]]\nname = \"lip\"\nbackend = \"servo\"\nline = 18\n"
-                                                   "gains = { w = 1 }\nmin = 0\nmax = 1\n")
+    const std::string jaw =
+        "[[actuator]]\nname = \"jaw\"\nbackend = \"servo\"\nline = 18\ngains = { open = 1 }\n";
+    EXPECT_NE(errorOf(jaw + "min = 0\nmax = 1\nslwe = 3\n").find(":9: unknown key"),
+              std::string::npos);  // unknown key
+    EXPECT_NE(errorOf(jaw + "min = \"0\"\nmax = 1\n").find(":7:"),
+              std::string::npos);  // wrong type
+    EXPECT_NE(errorOf(jaw + "min = 0.8\nmax = 0.2\n").find("greater than min"),
+              std::string::npos);  // min > max
+    EXPECT_NE(errorOf(jaw + "min = 0\nmax = 1\n" +
+                      "[[actuator]]\nname = \"lip\"\nbackend = \"servo\"\nline = 18\n"
+                      "gains = { w = 1 }\nmin = 0\nmax = 1\n")
                   .find(":9: GPIO gpiochip0 line 18 is used by two actuators"),
               std::string::npos);
     EXPECT_NE(errorOf(jaw + "min = 0\nmax = 1\nrest = 2\n").find("rest"), std::string::npos);
-    EXPECT_NE(errorOf("[[actuator]]\nname = \"j\"\nbackend = \"hid\"\ndevice = \"nope\"\ngains = { open = 1 }\nmin = 0\nmax = 1\n")
+    EXPECT_NE(errorOf("[[actuator]]\nname = \"j\"\nbackend = \"hid\"\ndevice = \"nope\"\ngains = { "
+                      "open = 1 }\nmin = 0\nmax = 1\n")
                   .find("no [[hid]] named 'nope'"),
               std::string::npos);
-    EXPECT_NE(errorOf(jaw + "min = 0\nmax = 1\nbackend2 = 1\n").find("backend2"), std::string::npos);
+    EXPECT_NE(errorOf(jaw + "min = 0\nmax = 1\nbackend2 = 1\n").find("backend2"),
+              std::string::npos);
 }
 
 TEST(PuppetFiles, PosesTheWeightsLackAreNamed) {

@@ -1,25 +1,26 @@
 // Fakes behind the hardware seams, and small puppets written in tests.
 #pragma once
 
-#include <lipsyncd/output.hpp>
+#include <unistd.h>
 
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <lipsyncd/output.hpp>
 #include <mutex>
-#include <unistd.h>
 
 namespace lipsyncd::test {
 
 inline std::filesystem::path writePuppet(const std::string& name, const std::string& toml) {
-    const auto path = std::filesystem::temp_directory_path() / ("lipsyncd_" + std::to_string(::getpid()) + "_" + name + ".toml");
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("lipsyncd_" + std::to_string(::getpid()) + "_" + name + ".toml");
     std::ofstream(path) << toml;
     return path;
 }
 
 // Records every edge with the fake clock's time.
 class FakeGpioLine : public output::GpioLine {
-public:
+  public:
     explicit FakeGpioLine(const std::int64_t* clock) : clock_(clock) {}
     void set(bool high) override {
         std::lock_guard lock(mutex_);
@@ -28,7 +29,7 @@ public:
     std::vector<std::pair<std::int64_t, bool>> edges;
     std::mutex mutex_;
 
-private:
+  private:
     const std::int64_t* clock_;
 };
 
@@ -39,7 +40,7 @@ struct FakeHidBoard {
 };
 
 class FakeHidDevice : public output::HidDevice {
-public:
+  public:
     explicit FakeHidDevice(FakeHidBoard& board) : board_(&board) {}
     bool write(std::span<const std::uint8_t> report) override {
         if (!board_->present) return false;
@@ -47,7 +48,7 @@ public:
         return true;
     }
 
-private:
+  private:
     FakeHidBoard* board_;
 };
 

@@ -14,15 +14,13 @@
 //                  RELOADING, STOPPING), SIGHUP reload and SIGTERM rest-then-exit.
 #pragma once
 
-#include <lipsyncd/core.hpp>
-
-#include <nlohmann/json_fwd.hpp>
-
 #include <cstdint>
 #include <deque>
 #include <filesystem>
 #include <functional>
+#include <lipsyncd/core.hpp>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <span>
 #include <string>
@@ -46,11 +44,11 @@ struct DaemonConfig {
     std::string runtime = "bigram";  // bigram | filter
     std::string templates;           // empty: the shipped default
     std::string voice = "en-us";
-    double leadSeconds = 0.05;       // drive the mouth this much ahead of the sound (servo lag)
-    double syncOffsetSeconds = 0;    // the user's correction, + moves the mouth later
-    bool hardware = true;            // open the puppet's GPIO/HID outputs
-    std::string record;              // also record every actuator command here (CSV)
-    bool terminal = false;           // show the actuators as bars on stderr
+    double leadSeconds = 0.05;     // drive the mouth this much ahead of the sound (servo lag)
+    double syncOffsetSeconds = 0;  // the user's correction, + moves the mouth later
+    bool hardware = true;          // open the puppet's GPIO/HID outputs
+    std::string record;            // also record every actuator command here (CSV)
+    bool terminal = false;         // show the actuators as bars on stderr
     // [live]
     std::string captureDevice = "default";  // an ALSA capture device, or "file:PATH.wav" (tests)
     int captureRate = 16000;
@@ -63,7 +61,7 @@ struct DaemonConfig {
 };
 
 class AudioSink {
-public:
+  public:
     virtual ~AudioSink() = default;
     virtual void open(int rate) = 0;  // mono float at `rate`
     // Takes what fits now without blocking; returns how many samples it took.
@@ -78,7 +76,7 @@ std::unique_ptr<AudioSink> openAudioSink(const std::string& device);
 // Live sound in: samples as they arrive, never blocking. ALSA capture, or a WAV file delivered
 // at real-time pace (what tests and latency measurements use).
 class CaptureSource {
-public:
+  public:
     virtual ~CaptureSource() = default;
     virtual int rate() const = 0;
     virtual std::size_t read(std::span<float> out) = 0;  // what has arrived (0 when nothing)
@@ -94,24 +92,25 @@ struct Clip {
 
 // The pieces a request needs to become a Clip, loaded from the config at start and on reload.
 class ClipMaker {
-public:
+  public:
     explicit ClipMaker(const DaemonConfig& config);
     ~ClipMaker();
     Clip fromFile(const std::filesystem::path& file, int channel) const;
     // espeak-ng allows one synthesiser per process, for the process's life: the daemon owns it.
-    Clip fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice) const;
+    Clip fromText(EspeakSynthesizer& synth, const std::string& text,
+                  const std::string& voice) const;
     const std::vector<std::string>& poseNames() const;
     // The live path: front end and runtime in their streaming forms (causal: least delay).
     class Live;
     std::unique_ptr<Live> startLive(int rate) const;
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 
 class ClipMaker::Live {
-public:
+  public:
     virtual ~Live() = default;
     // Feeds captured samples; appends the weight frames that became final to `out`.
     virtual void push(std::span<const float> samples, PoseTrack& out) = 0;
@@ -119,7 +118,7 @@ public:
 };
 
 class Daemon {
-public:
+  public:
     explicit Daemon(std::filesystem::path configFile);
     ~Daemon();
     // Runs until SIGTERM/SIGINT (or a "quit" request in tests): returns the exit code.
@@ -127,7 +126,7 @@ public:
     // One JSON request, one JSON reply (the socket's protocol; public for tests).
     nlohmann::json handle(const nlohmann::json& request);
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

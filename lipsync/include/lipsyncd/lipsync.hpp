@@ -14,10 +14,9 @@
 //   animateFilter()  the viseme-space filter of paper 001, section 5: a second, simpler runtime.
 #pragma once
 
-#include <lipsyncd/core.hpp>
-
 #include <cstddef>
 #include <filesystem>
+#include <lipsyncd/core.hpp>
 #include <optional>
 #include <span>
 #include <string>
@@ -43,9 +42,9 @@ struct PoseConstraint {
 };
 
 class PoseSet {
-public:
+  public:
     static PoseSet load(const std::filesystem::path& file);  // validates; InputError
-    static PoseSet named(const std::string& nameOrPath);     // "facefx" → config/poses/facefx.toml
+    static PoseSet named(const std::string& nameOrPath);  // "facefx" → config/poses/facefx.toml
 
     const std::string& name() const { return name_; }
     std::size_t size() const { return poses_.size(); }
@@ -58,7 +57,7 @@ public:
 
     PoseSet(std::string name, std::vector<Pose> poses, std::vector<PoseConstraint> constraints);
 
-private:
+  private:
     std::string name_;
     std::vector<Pose> poses_;
     std::vector<PoseConstraint> constraints_;
@@ -78,18 +77,18 @@ struct ControlPoint {
 // plane; it starts and ends on the polygon's end points and stays inside its convex hull, so
 // values stay in [0, 1]. It is sampled densely once, at load time.
 class ControlCurve {
-public:
+  public:
     explicit ControlCurve(std::vector<ControlPoint> polygon);  // validated by the caller
-    float at(double u) const;                                   // u in [0, 1], clamped
+    float at(double u) const;                                  // u in [0, 1], clamped
     std::span<const ControlPoint> polygon() const { return polygon_; }
 
-private:
+  private:
     std::vector<ControlPoint> polygon_;
     std::vector<float> samples_;  // c(u) at u = i / (samples_.size() - 1)
 };
 
 class BigramCurveSet {
-public:
+  public:
     // A curve set (format "lipsyncd-curves") or a character file ("lipsyncd-character": a base
     // set plus overridden bigrams). Validates everything; errors name the bigram and pose.
     static BigramCurveSet load(const std::filesystem::path& file, const PoseSet& poses,
@@ -111,13 +110,14 @@ public:
     std::size_t classes() const { return classes_; }
     std::size_t poses() const { return poses_; }
     // Writes the set (format "lipsyncd-curves", version 1), deterministically.
-    void save(const std::filesystem::path& file, const PoseSet& poseSet, const PhonemeSet& set) const;
+    void save(const std::filesystem::path& file, const PoseSet& poseSet,
+              const PhonemeSet& set) const;
     // Writes only the bigrams that involve class `onlyWith`, as a character file on `base`
     // (a language's additions to a set: paper 000, section 4.4).
-    void saveAdditions(const std::filesystem::path& file, const std::string& base, std::size_t onlyWith,
-                       const PoseSet& poseSet, const PhonemeSet& set) const;
+    void saveAdditions(const std::filesystem::path& file, const std::string& base,
+                       std::size_t onlyWith, const PoseSet& poseSet, const PhonemeSet& set) const;
 
-private:
+  private:
     static BigramCurveSet loadSet(const std::filesystem::path& file, const PoseSet& poses,
                                   const PhonemeSet& phonemes, bool requireEveryPair);
     void requireEveryPair(const std::filesystem::path& file, const PhonemeSet& phonemes) const;
@@ -155,7 +155,8 @@ struct PoseCurves {
     std::size_t frames = 0;
     std::vector<std::vector<float>> values;  // [pose][frame]
 
-    PoseCurves(std::size_t poses, double rate, double startTime, std::size_t firstFrame, std::size_t frames);
+    PoseCurves(std::size_t poses, double rate, double startTime, std::size_t firstFrame,
+               std::size_t frames);
     double timeOf(std::size_t frame) const {
         return startTime + static_cast<double>(firstFrame + frame) / rate;
     }
@@ -163,8 +164,9 @@ struct PoseCurves {
 
 // The steps, in the paper's order (each in its own file, each with its own tests).
 // Pairs (p_i, p_i+1) over (t_i, t_i+2), curves warped onto that span (each phoneme's half of
-// normalised time onto that phoneme), overlaps stitched with max (2.2.1). The schedule is bracketed by zero-length silence (where it starts and ends,
-// unless told it continues), so the first and last phonemes are covered by a pair too.
+// normalised time onto that phoneme), overlaps stitched with max (2.2.1). The schedule is bracketed
+// by zero-length silence (where it starts and ends, unless told it continues), so the first and
+// last phonemes are covered by a pair too.
 struct Bracket {
     bool start = true, end = true;
 };
@@ -200,7 +202,7 @@ PoseTrack animateFilter(std::span<const PhonemeSegment> schedule, const BigramCu
 // boundary are computed against an estimate (the current phoneme continued, for its mean
 // duration so far) and go out at once.
 class StreamingRuntime {
-public:
+  public:
     StreamingRuntime(const BigramCurveSet& set, const PoseSet& poses, double delaySeconds,
                      const RuntimeConfig& config = {},
                      const PhonemeSet& phonemes = PhonemeSet::common());
@@ -213,7 +215,7 @@ public:
     void preview(const std::string& phoneme, double until, PoseTrack& out);
     double delaySeconds() const { return delay_; }
 
-private:
+  private:
     void emitUntil(double until, bool final, PoseTrack& out, const PhonemeSegment* open = nullptr);
     void dropOldSegments();
     double longestWindow() const;
@@ -225,10 +227,10 @@ private:
     double delay_;
     std::vector<PhonemeSegment> window_;  // recent segments (older ones are dropped)
     bool started_ = false;
-    bool atStart_ = true;                 // window_ still holds the first segment
-    double origin_ = 0;                   // time of frame 0: the first segment's start
-    std::size_t emitted_ = 0;             // frames already out
-    std::vector<float> last_;             // the last frame out
+    bool atStart_ = true;      // window_ still holds the first segment
+    double origin_ = 0;        // time of frame 0: the first segment's start
+    std::size_t emitted_ = 0;  // frames already out
+    std::vector<float> last_;  // the last frame out
 };
 
 }  // namespace lipsyncd::lipsync

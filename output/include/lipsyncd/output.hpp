@@ -14,14 +14,13 @@
 //   GpioLine, HidDevice  the hardware seams: real (libgpiod, hidapi) and fakes for tests.
 #pragma once
 
-#include <lipsyncd/core.hpp>
-
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
+#include <lipsyncd/core.hpp>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -41,7 +40,7 @@ enum class Backend { Servo, Switch, Hid, Virtual };
 struct ActuatorConfig {
     std::string name;
     Backend backend = Backend::Virtual;
-    std::size_t line = 0;            // file line of [[actuator]], for messages
+    std::size_t line = 0;  // file line of [[actuator]], for messages
     // Address: GPIO chip and line offset (servo, switch); HID device name and channel (hid).
     std::string chip;
     unsigned gpioLine = 0;
@@ -53,10 +52,10 @@ struct ActuatorConfig {
     bool invert = false;
     // Safety.
     double min = 0, max = 1;
-    double deadband = 0;      // changes smaller than this are not sent (a buzzing jaw)
-    double slew = 5;          // units per second
-    double rest = 0;          // where it goes on stop, fault, signal or stall
-    double idleAfter = 2;     // a servo at rest this long gets no more pulses (0: never relax)
+    double deadband = 0;   // changes smaller than this are not sent (a buzzing jaw)
+    double slew = 5;       // units per second
+    double rest = 0;       // where it goes on stop, fault, signal or stall
+    double idleAfter = 2;  // a servo at rest this long gets no more pulses (0: never relax)
     // Servo pulses: min ↦ pulseMinUs, max ↦ pulseMaxUs.
     double pulseMinUs = 1000, pulseMaxUs = 2000, frequencyHz = 50;
     // Switch: on above threshold + hysteresis/2, off below threshold − hysteresis/2.
@@ -71,10 +70,10 @@ struct HidDeviceConfig {
     std::uint16_t vid = 0, pid = 0;
     std::string serial, path;  // optional: pick one board among several, or open by path
     std::uint8_t reportId = 0;
-    std::size_t reportSize = 16;    // bytes after the report id
+    std::size_t reportSize = 16;  // bytes after the report id
     HidEncoding encoding = HidEncoding::U8;
-    double rateHz = 50;             // reports per second
-    double reopenSeconds = 1;       // how often to look for an unplugged board
+    double rateHz = 50;        // reports per second
+    double reopenSeconds = 1;  // how often to look for an unplugged board
 };
 
 struct Puppet {
@@ -95,25 +94,25 @@ struct Puppet {
 // One actuator.
 
 struct ActuatorCommand {
-    double value = 0;     // within [min, max], always
-    bool active = true;   // false: a servo relaxed (no pulses) / a switch's state in `on`
-    bool on = false;      // switches only
+    double value = 0;    // within [min, max], always
+    bool active = true;  // false: a servo relaxed (no pulses) / a switch's state in `on`
+    bool on = false;     // switches only
 };
 
 class SwitchLogic {
-public:
+  public:
     explicit SwitchLogic(const ActuatorConfig& config);
     bool update(double time, double value);  // the switch state after this value
     bool on() const { return on_; }
 
-private:
+  private:
     double onAbove_, offBelow_, minOn_, minOff_;
     bool on_ = false;
     double since_ = -1e9;  // time of the last change
 };
 
 class ActuatorChannel {
-public:
+  public:
     // `poseIndex[k]` is the track column of gain k.
     ActuatorChannel(const ActuatorConfig& config, std::vector<std::size_t> poseIndex);
     // Steps to `time` toward the target the weights give (or toward rest); returns the command.
@@ -123,14 +122,14 @@ public:
     const ActuatorConfig& config() const { return config_; }
     double value() const { return value_; }
 
-private:
+  private:
     ActuatorCommand moveToward(double time, double target);
 
     ActuatorConfig config_;
     std::vector<std::size_t> poseIndex_;
-    double value_;            // the last commanded value
-    double lastTarget_;       // the last good (finite) target
-    double lastTime_ = -1;    // -1: no step yet
+    double value_;          // the last commanded value
+    double lastTarget_;     // the last good (finite) target
+    double lastTime_ = -1;  // -1: no step yet
     double restingSince_ = 0;
     std::optional<SwitchLogic> switch_;
 };
@@ -139,7 +138,7 @@ private:
 // Sinks.
 
 class CommandSink {
-public:
+  public:
     virtual ~CommandSink() = default;
     // One call per step with every actuator's command, in puppet order.
     virtual void write(double time, std::span<const ActuatorCommand> commands) = 0;
@@ -147,12 +146,12 @@ public:
 
 // Every command with its time: CSV (time,actuator,value,active) or JSON lines.
 class RecorderSink : public CommandSink {
-public:
+  public:
     enum class Format { Csv, JsonLines };
     RecorderSink(std::ostream& out, const Puppet& puppet, Format format);
     void write(double time, std::span<const ActuatorCommand> commands) override;
 
-private:
+  private:
     std::ostream* out_;
     std::vector<std::string> names_;
     Format format_;
@@ -160,11 +159,11 @@ private:
 
 // A live bar per actuator, redrawn in place (for the demo and tuning without hardware).
 class TerminalSink : public CommandSink {
-public:
+  public:
     TerminalSink(std::ostream& out, const Puppet& puppet, double refreshHz = 25);
     void write(double time, std::span<const ActuatorCommand> commands) override;
 
-private:
+  private:
     std::ostream* out_;
     const Puppet* puppet_;
     double period_, lastDraw_ = -1e9;
@@ -173,28 +172,30 @@ private:
 
 // A GPIO output line (libgpiod 1.6 for real; a fake in tests).
 class GpioLine {
-public:
+  public:
     virtual ~GpioLine() = default;
     virtual void set(bool high) = 0;
 };
 // Opens `line` of `chip` (a name such as "gpiochip0", a path, or a label) as an output, low.
 // InputError naming the chip and line when either is missing or busy.
-std::unique_ptr<GpioLine> openGpioLine(const std::string& chip, unsigned line, const std::string& consumer);
+std::unique_ptr<GpioLine> openGpioLine(const std::string& chip, unsigned line,
+                                       const std::string& consumer);
 // The GPIO chips present, with their lines: "gpiochip0 [label] 54 lines" and one line each.
 std::vector<std::string> listGpioChips();
 
 // Software PWM for servos: one thread for all servos of a puppet, absolute-deadline sleeps on
 // CLOCK_MONOTONIC, SCHED_FIFO where permitted. Commands set pulse widths; relaxed servos get none.
 class ServoPwm {
-public:
+  public:
     struct Servo {
         std::unique_ptr<GpioLine> line;
         double pulseMinUs, pulseMaxUs, min, max;
     };
     // `sleepUntil` is the clock (absolute deadline sleeps); tests pass a fake one.
-    using Clock = std::function<std::int64_t()>;                 // now, ns
+    using Clock = std::function<std::int64_t()>;                    // now, ns
     using SleepUntil = std::function<void(std::int64_t deadline)>;  // ns
-    ServoPwm(std::vector<Servo> servos, double frequencyHz, Clock clock = {}, SleepUntil sleep = {});
+    ServoPwm(std::vector<Servo> servos, double frequencyHz, Clock clock = {},
+             SleepUntil sleep = {});
     ~ServoPwm();
     ServoPwm(const ServoPwm&) = delete;
     ServoPwm& operator=(const ServoPwm&) = delete;
@@ -202,9 +203,10 @@ public:
     void runPeriods(int periods);  // for tests and benchmarks: run the loop inline
     void start();                  // the real-time thread
     bool realtime() const { return realtime_; }
-    static double pulseUs(double value, double min, double max, double pulseMinUs, double pulseMaxUs);
+    static double pulseUs(double value, double min, double max, double pulseMinUs,
+                          double pulseMaxUs);
 
-private:
+  private:
     void period(std::int64_t start);
 
     std::vector<Servo> servos_;
@@ -218,29 +220,31 @@ private:
 };
 
 class GpioServoSink : public CommandSink {
-public:
-    GpioServoSink(const Puppet& puppet, std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open = {});
+  public:
+    GpioServoSink(const Puppet& puppet,
+                  std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open = {});
     void write(double time, std::span<const ActuatorCommand> commands) override;
     ServoPwm& pwm() { return *pwm_; }
 
-private:
+  private:
     std::vector<std::size_t> actuator_;  // servo k is actuator actuator_[k]
     std::unique_ptr<ServoPwm> pwm_;
 };
 
 class GpioSwitchSink : public CommandSink {
-public:
-    GpioSwitchSink(const Puppet& puppet, std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open = {});
+  public:
+    GpioSwitchSink(const Puppet& puppet,
+                   std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open = {});
     void write(double time, std::span<const ActuatorCommand> commands) override;
 
-private:
+  private:
     std::vector<std::pair<std::size_t, std::unique_ptr<GpioLine>>> lines_;
     std::vector<int> state_;
 };
 
 // A USB HID board (hidapi for real; a fake in tests).
 class HidDevice {
-public:
+  public:
     virtual ~HidDevice() = default;
     virtual bool write(std::span<const std::uint8_t> report) = 0;  // false: gone
 };
@@ -252,15 +256,15 @@ std::vector<std::string> listHidDevices();  // "VID:PID serial path product" lin
 // One sink per HID board: channels in report order, encoded, sent at the board's rate; an
 // unplugged board is reopened every reopenSeconds while the others go on.
 class HidSink : public CommandSink {
-public:
+  public:
     HidSink(const Puppet& puppet, const HidDeviceConfig& device, HidOpener open = openHidapiDevice,
             std::function<void(const std::string&)> log = {});
     void write(double time, std::span<const ActuatorCommand> commands) override;
     bool connected() const { return device_ != nullptr; }
-    static void encode(std::span<std::uint8_t> report, std::size_t channel, double value, double min,
-                       double max, HidEncoding encoding);
+    static void encode(std::span<std::uint8_t> report, std::size_t channel, double value,
+                       double min, double max, HidEncoding encoding);
 
-private:
+  private:
     HidDeviceConfig config_;
     std::vector<std::pair<std::size_t, const ActuatorConfig*>> channels_;  // (actuator, config)
     HidOpener open_;
@@ -276,10 +280,11 @@ private:
 // Opens every hardware output the puppet names (servo, switch, HID) and adds it to `driver`.
 // GPIO errors are InputErrors naming chip and line; an absent HID board is waited for.
 class PuppetDriver;
-void addHardwareSinks(PuppetDriver& driver, const Puppet& puppet, std::function<void(const std::string&)> log);
+void addHardwareSinks(PuppetDriver& driver, const Puppet& puppet,
+                      std::function<void(const std::string&)> log);
 
 class PuppetDriver {
-public:
+  public:
     // `poses`: the weight columns update() receives (resolved against the puppet's gains).
     PuppetDriver(const Puppet& puppet, std::span<const std::string> poses);
     void addSink(std::unique_ptr<CommandSink> sink);
@@ -292,12 +297,13 @@ public:
     void tick(double time);
     // Stop, fault or signal: steps toward rest (slew-limited) at `stepHz` until there, calling
     // `sleepUntilTime` between steps (none: as fast as possible). Returns the time it got there.
-    double rest(double time, double stepHz = 100, const std::function<void(double)>& sleepUntilTime = {});
+    double rest(double time, double stepHz = 100,
+                const std::function<void(double)>& sleepUntilTime = {});
     bool atRest() const;
     std::span<const ActuatorCommand> last() const { return last_; }
     const Puppet& puppet() const { return *puppet_; }
 
-private:
+  private:
     void send(double time);
 
     const Puppet* puppet_;
