@@ -226,25 +226,16 @@ void writeSet(const std::filesystem::path& file, const json& header, const json&
 
 void BigramCurveSet::save(const std::filesystem::path& file, const PoseSet& poseSet,
                           const PhonemeSet& set) const {
-    json header = json::object();
-    header["format"] = kCurvesFormat;
-    header["version"] = kVersion;
-    header["name"] = name_;
-    header["description"] = description_;
-    header["pose_set"] = poseSet.name();
+    const json header = {{"format", kCurvesFormat}, {"version", kVersion}, {"name", name_},
+                         {"description", description_}, {"pose_set", poseSet.name()}};
     writeSet(file, header, bigramsJson(*this, poseSet, set, std::nullopt));
 }
 
 void BigramCurveSet::saveAdditions(const std::filesystem::path& file, const std::string& base,
                                    std::size_t onlyWith, const PoseSet& poseSet,
                                    const PhonemeSet& set) const {
-    json header = json::object();
-    header["format"] = kCharacterFormat;
-    header["version"] = kVersion;
-    header["name"] = name_;
-    header["description"] = description_;
-    header["base"] = base;
-    header["pose_set"] = poseSet.name();
+    const json header = {{"format", kCharacterFormat}, {"version", kVersion}, {"name", name_},
+                         {"description", description_}, {"base", base}, {"pose_set", poseSet.name()}};
     writeSet(file, header, bigramsJson(*this, poseSet, set, onlyWith));
 }
 

@@ -86,8 +86,9 @@ TEST(RuntimeProperties, ShortLongAndSingleSchedulesBehave) {
         ASSERT_GE(track.frames(), 1u);
         expectBoundsSpeedAndConstraints(track, sh.poses, 100);
         // Silence at the end lets the mouth come back to rest.
-        if (s.back().phoneme == "sil")
+        if (s.back().phoneme == "sil") {
             for (float v : track.frame(track.frames() - 1)) EXPECT_LT(v, 0.05f);
+        }
     }
     // A long vowel holds its pose rather than sagging in the middle.
     const auto held = lipsync::animate(

@@ -60,7 +60,9 @@ TEST(ActuatorSafety, CommandsStayWithinLimitsAndSlewWhateverComesIn) {
         ASSERT_TRUE(std::isfinite(v));
         ASSERT_GE(v, 0.1);
         ASSERT_LE(v, 0.8);
-        if (i > 0) ASSERT_LE(std::abs(v - sink.seen[i - 1].second.value), 4.0 * 0.01 + 1e-9) << i;
+        if (i > 0) {
+            ASSERT_LE(std::abs(v - sink.seen[i - 1].second.value), 4.0 * 0.01 + 1e-9) << i;
+        }
     }
 }
 
