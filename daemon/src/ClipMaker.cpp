@@ -45,7 +45,10 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
     decode.channel = channel;
     Clip clip;
     clip.name = file.string();
-    const auto audio = dsp::readAudioFile(file, decode);
+    // Analysed on `channel` (the voice), played on the others (what the audience hears).
+    dsp::DecodeOptions play;
+    play.skipChannel = channel;
+    const auto audio = dsp::readAudioFile(file, play);
     clip.samples = audio.samples;
     clip.rate = audio.sampleRate;
     const auto result = dsp::analyzeFile(file, impl_->templates, PhonemeSet::common(), {}, decode);

@@ -55,6 +55,7 @@ struct AudioDecoder::State {
     SF_INFO info{};
     std::string name;
     int channel = -1;
+    int skipChannel = -1;
     std::vector<float> interleaved;
     std::int64_t nonFinite = 0;
 };
@@ -97,6 +98,8 @@ AudioDecoder AudioDecoder::open(const std::filesystem::path& file, const DecodeO
                          " channel(s); --channel " + std::to_string(options.channel) +
                          " does not exist (channels count from 0)");
     s->channel = options.channel;
+    // Skipping the only channel would leave nothing: then it is simply played.
+    s->skipChannel = s->info.channels > 1 ? options.skipChannel : -1;
     s->interleaved.resize(kBlockFrames * static_cast<std::size_t>(s->info.channels));
     // libsndfile scales integer PCM to [-1, 1); floats are passed through as they are.
     sf_command(f, SFC_SET_NORM_FLOAT, nullptr, SF_TRUE);
@@ -137,8 +140,9 @@ std::size_t AudioDecoder::read(std::span<float> out) {
         if (s.channel >= 0) {
             v = frame[s.channel];
         } else {
-            for (std::size_t c = 0; c < channels; ++c) v += frame[c];
-            v /= static_cast<float>(channels);
+            for (std::size_t c = 0; c < channels; ++c)
+                if (static_cast<int>(c) != s.skipChannel) v += frame[c];
+            v /= static_cast<float>(s.skipChannel >= 0 ? channels - 1 : channels);
         }
         if (!std::isfinite(v)) {
             ++s.nonFinite;

@@ -201,3 +201,16 @@ TEST(FrontEnd, TenHoursOfSilenceStreamInBoundedMemory) {
     EXPECT_LT(maxRssKb() - before, 4096) << "peak memory grew by more than 4 MiB";
     EXPECT_EQ(segments, 1u);  // one long silence
 }
+
+TEST(FrontEnd, AShowFileCanLeaveTheVoiceChannelOutOfTheMix) {
+    // Voice on channel 0, the audience track (here: the voice at a quarter) on channel 1.
+    const auto& s = lipsyncd::test::testSpeech();
+    const auto file = lipsyncd::test::writeAudio("show.wav", s.samples, s.rate,
+                                                 SF_FORMAT_WAV | SF_FORMAT_FLOAT, {1.0f, 0.25f});
+    lipsyncd::dsp::DecodeOptions others;
+    others.skipChannel = 0;
+    const auto played = lipsyncd::dsp::readAudioFile(file, others);
+    ASSERT_EQ(played.samples.size(), s.samples.size());
+    for (std::size_t i = 0; i < s.samples.size(); i += 997)
+        EXPECT_NEAR(played.samples[i], 0.25f * s.samples[i], 1e-6);
+}

@@ -65,8 +65,9 @@ TEST(StreamResampler, ReportedDelayBoundsTheMeasuredOne) {
             const auto [latency, peakAt] = impulseLatency(quality, impulse);
             ASSERT_GT(latency, 0);
             worst = std::max(worst, latency);
-            if (quality == dsp::ResamplerQuality::Medium)  // linear phase: output time-aligned
+            if (quality == dsp::ResamplerQuality::Medium) {  // linear phase: output time-aligned
                 EXPECT_NEAR(peakAt, impulse / 16000.0, 1.5 / 10000);
+            }
         }
         EXPECT_LE(worst, reported + 0.001);
         EXPECT_GE(worst, reported - 0.012) << "reported " << reported;

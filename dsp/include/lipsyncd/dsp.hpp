@@ -44,6 +44,9 @@ struct RawFormat {
 struct DecodeOptions {
     // -1: mix all channels to mono; otherwise the 0-based channel to keep.
     int channel = -1;
+    // With channel == -1: leave this channel out of the mix (a show file's voice channel is
+    // analysed, the others are what the audience hears).
+    int skipChannel = -1;
 };
 
 class AudioDecoder {
