@@ -18,12 +18,6 @@ extern "C" void onStopSignal(int) {
     gStop = 1;
 }
 
-std::filesystem::path puppetFile(const std::string& nameOrPath) {
-    const std::filesystem::path p(nameOrPath);
-    if (p.has_extension() || p.has_parent_path()) return findDataFile(p);
-    return findDataFile(std::filesystem::path("puppets") / (nameOrPath + ".toml"));
-}
-
 struct DriveOptions {
     std::string weights, puppet, record;
     bool realtime = false, terminal = false, noHardware = false;
@@ -34,7 +28,7 @@ void say(const std::string& what) {
 }
 
 void runDrive(const DriveOptions& o) {
-    const auto puppet = output::Puppet::load(puppetFile(o.puppet));
+    const auto puppet = output::Puppet::named(o.puppet);
     const auto track = readPoseTrackCsvFile(o.weights);
     output::PuppetDriver driver(puppet, track.poses);
     if (!o.noHardware) output::addHardwareSinks(driver, puppet, say);
@@ -107,7 +101,7 @@ void addDriveCommands(CLI::App& app) {
     check->add_option("--puppet", *puppet, "Puppet file or name")->required();
     check->add_option("--weights", *weights, "Also check its poses against this weights file");
     check->callback([puppet, weights] {
-        const auto p = output::Puppet::load(puppetFile(*puppet));
+        const auto p = output::Puppet::named(*puppet);
         if (!weights->empty()) p.checkPoses(readPoseTrackCsvFile(*weights).poses);
         p.describe(std::cout);
     });

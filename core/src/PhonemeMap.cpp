@@ -43,10 +43,7 @@ PhonemeMap PhonemeMap::load(const std::filesystem::path& file) {
 }
 
 PhonemeMap PhonemeMap::named(std::string_view nameOrPath) {
-    const std::filesystem::path given(nameOrPath);
-    if (given.has_extension()) return load(findDataFile(given));
-    return load(
-        findDataFile(std::filesystem::path("phonemes") / (std::string(nameOrPath) + ".toml")));
+    return load(findNamedDataFile(std::string(nameOrPath), "phonemes", ".toml"));
 }
 
 std::string PhonemeMap::normalise(std::string_view symbol) const {

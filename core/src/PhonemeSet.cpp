@@ -51,14 +51,9 @@ const PhonemeSet& PhonemeSet::named(const std::string& nameOrPath) {
     static std::map<std::string, std::unique_ptr<PhonemeSet>> loaded;
     std::lock_guard lock(mutex);
     auto& slot = loaded[nameOrPath];
-    if (!slot) {
-        const std::filesystem::path p(nameOrPath);
-        const auto file =
-            p.has_extension() || p.has_parent_path()
-                ? findDataFile(p)
-                : findDataFile(std::filesystem::path("phonemes") / (nameOrPath + ".toml"));
-        slot = std::make_unique<PhonemeSet>(load(file));
-    }
+    if (!slot)
+        slot =
+            std::make_unique<PhonemeSet>(load(findNamedDataFile(nameOrPath, "phonemes", ".toml")));
     return *slot;
 }
 

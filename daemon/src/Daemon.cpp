@@ -42,12 +42,6 @@ void notify(const std::string& state) {
     sd_notify(0, state.c_str());
 }
 
-std::filesystem::path puppetFile(const std::string& nameOrPath) {
-    const std::filesystem::path p(nameOrPath);
-    if (p.has_extension() || p.has_parent_path()) return findDataFile(p);
-    return findDataFile(std::filesystem::path("puppets") / (nameOrPath + ".toml"));
-}
-
 double monotonicSeconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
         .count();
@@ -65,7 +59,7 @@ struct Setup {
 
     explicit Setup(const std::filesystem::path& file) : config(DaemonConfig::load(file)) {
         clips = std::make_unique<ClipMaker>(config);
-        puppet = std::make_unique<output::Puppet>(output::Puppet::load(puppetFile(config.puppet)));
+        puppet = std::make_unique<output::Puppet>(output::Puppet::named(config.puppet));
         driver = std::make_unique<output::PuppetDriver>(*puppet, clips->poseNames());
         if (config.hardware)
             output::addHardwareSinks(*driver, *puppet, [](const std::string& m) { warn(m); });
@@ -225,15 +219,19 @@ struct Daemon::Impl {
                 {"live_started", liveStarted}};
     }
 
+    // Moves the mouth to rest in real time (slew-limited steps, really waited for).
+    void restNow() {
+        setup->driver->rest(now(), 100, [this](double t) {
+            std::this_thread::sleep_for(std::chrono::duration<double>(std::max(0.0, t - now())));
+        });
+    }
+
     void reload() {
         notify("RELOADING=1");
         status("reloading " + configFile.string());
         try {
             auto fresh = std::make_unique<Setup>(configFile);
-            setup->driver->rest(now(), 100, [this](double t) {
-                std::this_thread::sleep_for(
-                    std::chrono::duration<double>(std::max(0.0, t - now())));
-            });
+            restNow();
             queue.clear();
             current.reset();
             live.reset();
@@ -341,9 +339,7 @@ int Daemon::run() {
     d.status(std::string("stopping (") + (exitSignal ? strsignal(exitSignal) : "asked") +
              "): mouth to rest");
     if (d.current) d.setup->audio->stop();
-    d.setup->driver->rest(d.now(), 100, [&](double t) {
-        std::this_thread::sleep_for(std::chrono::duration<double>(std::max(0.0, t - d.now())));
-    });
+    d.restNow();
     info("at rest; bye");
     ::close(timer);
     ::close(sigfd);

@@ -177,10 +177,7 @@ void BigramCurveSet::applyOverrides(const std::filesystem::path& characterFile,
 
 BigramCurveSet BigramCurveSet::named(const std::string& nameOrPath, const PoseSet& poses,
                                      const PhonemeSet& phonemes) {
-    const std::filesystem::path p(nameOrPath);
-    if (p.has_extension() || p.has_parent_path()) return load(findDataFile(p), poses, phonemes);
-    return load(findDataFile(std::filesystem::path("curves") / (nameOrPath + ".json")), poses,
-                phonemes);
+    return load(findNamedDataFile(nameOrPath, "curves", ".json"), poses, phonemes);
 }
 
 namespace {
@@ -226,16 +223,20 @@ void writeSet(const std::filesystem::path& file, const json& header, const json&
 
 void BigramCurveSet::save(const std::filesystem::path& file, const PoseSet& poseSet,
                           const PhonemeSet& set) const {
-    const json header = {{"format", kCurvesFormat}, {"version", kVersion}, {"name", name_},
-                         {"description", description_}, {"pose_set", poseSet.name()}};
+    const json header = {{"format", kCurvesFormat},
+                         {"version", kVersion},
+                         {"name", name_},
+                         {"description", description_},
+                         {"pose_set", poseSet.name()}};
     writeSet(file, header, bigramsJson(*this, poseSet, set, std::nullopt));
 }
 
 void BigramCurveSet::saveAdditions(const std::filesystem::path& file, const std::string& base,
                                    std::size_t onlyWith, const PoseSet& poseSet,
                                    const PhonemeSet& set) const {
-    const json header = {{"format", kCharacterFormat}, {"version", kVersion}, {"name", name_},
-                         {"description", description_}, {"base", base}, {"pose_set", poseSet.name()}};
+    const json header = {
+        {"format", kCharacterFormat},  {"version", kVersion}, {"name", name_},
+        {"description", description_}, {"base", base},        {"pose_set", poseSet.name()}};
     writeSet(file, header, bigramsJson(*this, poseSet, set, onlyWith));
 }
 

@@ -88,9 +88,7 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
 }
 
 PoseSet PoseSet::named(const std::string& nameOrPath) {
-    const std::filesystem::path p(nameOrPath);
-    if (p.has_extension() || p.has_parent_path()) return load(findDataFile(p));
-    return load(findDataFile(std::filesystem::path("poses") / (nameOrPath + ".toml")));
+    return load(findNamedDataFile(nameOrPath, "poses", ".toml"));
 }
 
 }  // namespace lipsyncd::lipsync

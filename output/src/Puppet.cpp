@@ -156,6 +156,10 @@ Puppet Puppet::load(const std::filesystem::path& file) {
     return p;
 }
 
+Puppet Puppet::named(const std::string& nameOrPath) {
+    return load(findNamedDataFile(nameOrPath, "puppets", ".toml"));
+}
+
 void Puppet::checkPoses(std::span<const std::string> poses) const {
     for (const auto& a : actuators)
         for (const auto& [pose, gain] : a.gains)

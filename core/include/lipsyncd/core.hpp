@@ -39,6 +39,11 @@ class InputError : public std::runtime_error {
 std::filesystem::path dataDirectory();
 // `name` as given if it exists, else resolved against dataDirectory().
 std::filesystem::path findDataFile(const std::filesystem::path& name);
+// A shipped data file named the short way ("facefx" → config/poses/facefx.toml) or by path
+// (anything with an extension or a folder in it).
+std::filesystem::path findNamedDataFile(const std::string& nameOrPath,
+                                        const std::filesystem::path& folder,
+                                        const std::string& extension);
 
 // ---------------------------------------------------------------------------------------------
 // Phoneme classes.

@@ -84,6 +84,8 @@ struct Puppet {
     std::vector<HidDeviceConfig> hidDevices;
 
     static Puppet load(const std::filesystem::path& file);  // strict; InputError with the line
+    static Puppet named(
+        const std::string& nameOrPath);  // "terminal" → config/puppets/terminal.toml
     // Resolves gains against a track's pose names; InputError for a pose the track lacks.
     void checkPoses(std::span<const std::string> poses) const;
     // The resolved mapping, for `lipsync check`.
