@@ -62,16 +62,19 @@ std::string openError(const std::string& path, int error) {
 }
 }  // namespace
 
-std::unique_ptr<I2cDevice> openI2cDevice(unsigned bus, unsigned address) {
-    const std::string path = "/dev/i2c-" + std::to_string(bus);
+std::unique_ptr<I2cDevice> openI2cDevice(unsigned bus, unsigned address,
+                                         const std::filesystem::path& dev) {
+    const std::string path = (dev / ("i2c-" + std::to_string(bus))).string();
     const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
     if (fd < 0) throw std::runtime_error(openError(path, errno));
     if (ioctl(fd, I2C_SLAVE, static_cast<unsigned long>(address)) != 0) {
         const int error = errno;
         ::close(fd);
-        throw std::runtime_error(path + " address " + hex(address) + ": " +
-                                 (error == EBUSY ? "taken by a kernel driver"
-                                                 : std::string(std::strerror(error))));
+        throw std::runtime_error(
+            path + " address " + hex(address) + ": " +
+            (error == EBUSY    ? "taken by a kernel driver"
+             : error == ENOTTY ? "not an I2C bus"
+                               : std::string(std::strerror(error))));
     }
     return std::make_unique<I2cDevDevice>(fd, address);
 }

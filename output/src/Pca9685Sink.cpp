@@ -54,7 +54,8 @@ Pca9685Sink::Pca9685Sink(const Puppet& puppet, unsigned bus, unsigned address, I
           boardName(bus, address), std::move(log)),
       bus_(bus),
       address_(address),
-      opener_(std::move(open)),
+      opener_(open ? std::move(open)
+                   : [](unsigned b, unsigned a) { return openI2cDevice(b, a); }),
       sent_(channels_.size(), -1) {
     if (!channels_.empty())  // (the puppet checks that a board's channels agree)
         prescale_ = prescale(channels_.front().config->oscillatorHz,

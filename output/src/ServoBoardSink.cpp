@@ -55,7 +55,7 @@ void addServoBoardSinks(PuppetDriver& driver, const Puppet& puppet, Log log,
     for (const auto& a : puppet.actuators) {
         if (a.backend == Backend::Pca9685 && pca.insert({a.i2cBus, a.i2cAddress}).second)
             driver.addSink(
-                std::make_unique<Pca9685Sink>(puppet, a.i2cBus, a.i2cAddress, openI2cDevice, log));
+                std::make_unique<Pca9685Sink>(puppet, a.i2cBus, a.i2cAddress, I2cOpener{}, log));
         if (a.backend == Backend::Maestro && maestro.insert(a.port).second)
             driver.addSink(std::make_unique<MaestroSink>(puppet, a.port, log));
         if (a.backend == Backend::Pwm && pwm.insert(a.pwmChip).second)

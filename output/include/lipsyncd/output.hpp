@@ -375,7 +375,8 @@ class I2cDevice {
 // Throws std::runtime_error saying why (no such bus, permission denied, address taken by a
 // kernel driver).
 using I2cOpener = std::function<std::unique_ptr<I2cDevice>(unsigned bus, unsigned address)>;
-std::unique_ptr<I2cDevice> openI2cDevice(unsigned bus, unsigned address);
+std::unique_ptr<I2cDevice> openI2cDevice(unsigned bus, unsigned address,
+                                         const std::filesystem::path& dev = "/dev");
 // "/dev/i2c-1" lines, each with the addresses 0x40–0x7F that answer (where readable).
 std::vector<std::string> listI2cBuses(const std::filesystem::path& dev = "/dev");
 
@@ -385,8 +386,8 @@ std::vector<std::string> listI2cBuses(const std::filesystem::path& dev = "/dev")
 // channel when the sink closes (after the rest pose).
 class Pca9685Sink : public ServoBoardSink {
   public:
-    Pca9685Sink(const Puppet& puppet, unsigned bus, unsigned address,
-                I2cOpener open = openI2cDevice, Log log = {});
+    Pca9685Sink(const Puppet& puppet, unsigned bus, unsigned address, I2cOpener open = {},
+                Log log = {});
     ~Pca9685Sink() override;
     static std::uint8_t prescale(double oscillatorHz, double frequencyHz);
     // LEDn_OFF count of a pulse: one tick is (prescale + 1) / oscillator.
