@@ -1,6 +1,6 @@
-// I2C through the kernel's i2c-dev interface (/dev/i2c-N): plain write() for register writes,
-// I2C_RDWR for a register read (write the register, repeated start, read). Open errors say
-// what a builder must do: enable the bus, join group i2c, free the address from a driver.
+// I2C through the kernel's i2c-dev interface (/dev/i2c-N; Linux i2c-dev): plain write() for
+// register writes, I2C_RDWR for a register read (write the register, repeated start, read).
+// Open errors say what a builder must do: enable the bus, join group i2c, free the address.
 #include <fcntl.h>
 #include <linux/i2c-dev.h>
 #include <linux/i2c.h>

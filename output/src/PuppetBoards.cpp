@@ -160,7 +160,8 @@ void checkBoardChannels(const Puppet& p) {
 void describeBoardAddress(std::ostream& out, const ActuatorConfig& a) {
     if (a.backend == Backend::Pca9685 || a.backend == Backend::Maestro ||
         a.backend == Backend::Pwm)
-        out << " " << where(a) << " channel " << a.channel;
+        out << " " << where(a) << " channel " << a.channel
+            << (a.backend == Backend::Maestro ? "; pulse period set on the board" : "");
 }
 
 void describeLinkage(std::ostream& out, const ActuatorConfig& a) {
