@@ -9,10 +9,9 @@
 //   build/bench/output_bench
 //   build/bench/output_bench --benchmark_filter='Frame'   # the servo boards only
 #include <benchmark/benchmark.h>
-#include <time.h>
-
 #include <fcntl.h>
 #include <stdlib.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -103,7 +102,7 @@ void PuppetStep(benchmark::State& state) {
 BENCHMARK(PuppetStep);
 
 const std::vector<std::string> kPoses{"open", "wide",      "w",           "pbm",        "fv",
-                                     "shch", "tongue_up", "tongue_down", "tongue_back"};
+                                      "shch", "tongue_up", "tongue_down", "tongue_back"};
 
 // Every channel moving every frame (the worst case: nothing skipped as unchanged).
 void driveFrames(benchmark::State& state, output::PuppetDriver& driver, std::size_t channels,
@@ -146,13 +145,12 @@ void Pca9685Frame(benchmark::State& state) {
         }
     };
     output::PuppetDriver driver(puppet, kPoses);
-    driver.addSink(std::make_unique<output::Pca9685Sink>(
-        puppet, 1, 0x40, [&](unsigned, unsigned) {
-            auto d = std::make_unique<Counting>();
-            d->chip = &chip;
-            d->bytes = &bytes;
-            return d;
-        }));
+    driver.addSink(std::make_unique<output::Pca9685Sink>(puppet, 1, 0x40, [&](unsigned, unsigned) {
+        auto d = std::make_unique<Counting>();
+        d->chip = &chip;
+        d->bytes = &bytes;
+        return d;
+    }));
     const std::vector<float> w(kPoses.size(), 0.0f);
     driver.update(0, w);  // the setup writes, not counted
     bytes = 0;
@@ -184,7 +182,8 @@ void MaestroFrame(benchmark::State& state) {
     std::size_t bytes = 0;
     std::uint8_t buf[65536];
     const auto drain = [&] {
-        for (ssize_t n; (n = ::read(master, buf, sizeof buf)) > 0;) bytes += static_cast<std::size_t>(n);
+        for (ssize_t n; (n = ::read(master, buf, sizeof buf)) > 0;)
+            bytes += static_cast<std::size_t>(n);
     };
     const std::vector<float> w(kPoses.size(), 0.0f);
     driver.update(0, w);

@@ -127,8 +127,8 @@ void addDriveCommands(CLI::App& app) {
 
     auto* devices =
         app.add_subcommand("devices",
-                          "List the GPIO chips, USB HID devices, I2C buses, serial ports and "
-                          "PWM chips present");
+                           "List the GPIO chips, USB HID devices, I2C buses, serial ports and "
+                           "PWM chips present");
     devices->callback([] {
         const auto chips = output::listGpioChips();
         std::cout << "GPIO chips (name them in a puppet as chip = \"gpiochipN\", line = OFFSET):\n";

@@ -98,7 +98,8 @@ GpioServoSink::GpioServoSink(const Puppet& puppet,
 
 void GpioServoSink::write(double, std::span<const ActuatorCommand> commands) {
     for (std::size_t k = 0; k < actuator_.size(); ++k)
-        pwm_->setPulse(k, servoPulseUs(puppet_->actuators[actuator_[k]], commands[actuator_[k]].value),
+        pwm_->setPulse(k,
+                       servoPulseUs(puppet_->actuators[actuator_[k]], commands[actuator_[k]].value),
                        commands[actuator_[k]].active);  // (through the linkage, if any)
 }
 

@@ -15,6 +15,8 @@
 #include <lipsyncd/output.hpp>
 #include <stdexcept>
 
+#include "DeviceFiles.hpp"
+
 namespace lipsyncd::output {
 
 namespace {
@@ -70,23 +72,17 @@ std::unique_ptr<I2cDevice> openI2cDevice(unsigned bus, unsigned address,
     if (ioctl(fd, I2C_SLAVE, static_cast<unsigned long>(address)) != 0) {
         const int error = errno;
         ::close(fd);
-        throw std::runtime_error(
-            path + " address " + hex(address) + ": " +
-            (error == EBUSY    ? "taken by a kernel driver"
-             : error == ENOTTY ? "not an I2C bus"
-                               : std::string(std::strerror(error))));
+        throw std::runtime_error(path + " address " + hex(address) + ": " +
+                                 (error == EBUSY    ? "taken by a kernel driver"
+                                  : error == ENOTTY ? "not an I2C bus"
+                                                    : std::string(std::strerror(error))));
     }
     return std::make_unique<I2cDevDevice>(fd, address);
 }
 
 std::vector<std::string> listI2cBuses(const std::filesystem::path& dev) {
-    std::vector<std::filesystem::path> buses;
-    std::error_code ec;
-    for (const auto& entry : std::filesystem::directory_iterator(dev, ec))
-        if (entry.path().filename().string().starts_with("i2c-")) buses.push_back(entry.path());
-    std::sort(buses.begin(), buses.end());
     std::vector<std::string> out;
-    for (const auto& path : buses) {
+    for (const auto& path : sortedEntries(dev, {"i2c-"})) {
         std::string name;
         std::getline(std::ifstream("/sys/class/i2c-dev/" + path.filename().string() + "/name"),
                      name);

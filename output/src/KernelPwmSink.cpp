@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "DeviceFiles.hpp"
+
 namespace lipsyncd::output {
 
 namespace {
@@ -63,7 +65,9 @@ KernelPwmSink::KernelPwmSink(const Puppet& puppet, unsigned chip, std::filesyste
                              Log log)
     : ServoBoardSink(
           puppet,
-          [chip](const ActuatorConfig& a) { return a.backend == Backend::Pwm && a.pwmChip == chip; },
+          [chip](const ActuatorConfig& a) {
+              return a.backend == Backend::Pwm && a.pwmChip == chip;
+          },
           "PWM chip " + (root / ("pwmchip" + std::to_string(chip))).string(), std::move(log)),
       chipDir_(root / ("pwmchip" + std::to_string(chip))),
       dutyFd_(channels_.size(), -1),
@@ -116,7 +120,8 @@ bool KernelPwmSink::send(std::span<const ActuatorCommand> commands) {
         const auto& [index, config] = channels_[k];
         const auto& c = commands[index];
         // Duty 0 is no pulse at all: a relaxed servo.
-        const std::int64_t duty = c.active ? std::llround(servoPulseUs(*config, c.value) * 1000) : 0;
+        const std::int64_t duty =
+            c.active ? std::llround(servoPulseUs(*config, c.value) * 1000) : 0;
         if (duty == sent_[k]) continue;
         if (!writeValue(dutyFd_[k], duty)) return false;
         sent_[k] = duty;
@@ -133,15 +138,10 @@ void KernelPwmSink::close() {
 
 std::vector<std::string> listPwmChips(const std::filesystem::path& root) {
     std::vector<std::string> out;
-    std::error_code ec;
-    std::vector<std::filesystem::path> chips;
-    for (const auto& e : std::filesystem::directory_iterator(root, ec))
-        if (e.path().filename().string().starts_with("pwmchip")) chips.push_back(e.path());
-    std::sort(chips.begin(), chips.end());
-    for (const auto& chip : chips) {
+    for (const auto& chip : sortedEntries(root, {"pwmchip"})) {
         const auto name = chip.filename().string();
-        out.push_back(name + ": " + std::to_string(channelCount(chip)) + " channels (chip = " +
-                      name.substr(7) + ")");
+        out.push_back(name + ": " + std::to_string(channelCount(chip)) +
+                      " channels (chip = " + name.substr(7) + ")");
     }
     return out;
 }

@@ -96,8 +96,7 @@ bool takesServoPulses(Backend backend) {
            backend == Backend::Maestro || backend == Backend::Pwm;
 }
 
-std::vector<LinkageRow> solveLinkage(const Linkage& l, double min, double max,
-                                     std::size_t steps) {
+std::vector<LinkageRow> solveLinkage(const Linkage& l, double min, double max, std::size_t steps) {
     if (!(l.horn > 0 && l.rod > 0 && l.arm > 0))
         throw InputError("horn, rod and arm must be longer than 0 mm");
     const Branch a = solveBranch(l, min, max, steps, +1);
@@ -126,7 +125,8 @@ double servoPulseUs(const ActuatorConfig& a, double value) {
     const double horn =
         table[i].hornDeg + (at - double(i)) * (table[i + 1].hornDeg - table[i].hornDeg);
     const auto& l = *a.linkage;
-    const double travel = (horn - l.hornAtPulseMinDeg) / (l.hornAtPulseMaxDeg - l.hornAtPulseMinDeg);
+    const double travel =
+        (horn - l.hornAtPulseMinDeg) / (l.hornAtPulseMaxDeg - l.hornAtPulseMinDeg);
     return a.pulseMinUs + std::clamp(travel, 0.0, 1.0) * (a.pulseMaxUs - a.pulseMinUs);
 }
 

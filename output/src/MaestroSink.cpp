@@ -16,6 +16,8 @@
 #include <lipsyncd/output.hpp>
 #include <stdexcept>
 
+#include "DeviceFiles.hpp"
+
 namespace lipsyncd::output {
 
 namespace {
@@ -25,12 +27,18 @@ constexpr int kWriteWaitMs = 2;  // how long a partly written frame may wait for
 
 speed_t baudConstant(unsigned baud) {
     switch (baud) {
-        case 9600: return B9600;
-        case 19200: return B19200;
-        case 38400: return B38400;
-        case 57600: return B57600;
-        case 230400: return B230400;
-        default: return B115200;
+        case 9600:
+            return B9600;
+        case 19200:
+            return B19200;
+        case 38400:
+            return B38400;
+        case 57600:
+            return B57600;
+        case 230400:
+            return B230400;
+        default:
+            return B115200;
     }
 }
 
@@ -71,7 +79,8 @@ unsigned MaestroSink::speed(const ActuatorConfig& a) {
     for (int i = 0; i < kSamples; ++i) {
         const double v0 = a.min + (a.max - a.min) * i / kSamples;
         const double v1 = a.min + (a.max - a.min) * (i + 1) / kSamples;
-        steepest = std::max(steepest, std::abs(servoPulseUs(a, v1) - servoPulseUs(a, v0)) / (v1 - v0));
+        steepest =
+            std::max(steepest, std::abs(servoPulseUs(a, v1) - servoPulseUs(a, v0)) / (v1 - v0));
     }
     const double quarterUsPer10ms = steepest * a.slew * 4 / 100;
     return static_cast<unsigned>(std::clamp(std::floor(quarterUsPer10ms), 1.0, 16383.0));
@@ -87,7 +96,9 @@ unsigned MaestroSink::acceleration(const ActuatorConfig& a) {
 MaestroSink::MaestroSink(const Puppet& puppet, const std::string& port, Log log)
     : ServoBoardSink(
           puppet,
-          [port](const ActuatorConfig& a) { return a.backend == Backend::Maestro && a.port == port; },
+          [port](const ActuatorConfig& a) {
+              return a.backend == Backend::Maestro && a.port == port;
+          },
           "Maestro on " + port, std::move(log)),
       port_(port),
       sent_(channels_.size(), kNone),
@@ -177,11 +188,7 @@ void MaestroSink::close() {
 std::vector<std::string> listSerialPorts(const std::filesystem::path& dev) {
     std::vector<std::string> out;
     std::error_code ec;
-    std::vector<std::filesystem::path> byId;
-    for (const auto& e : std::filesystem::directory_iterator(dev / "serial" / "by-id", ec))
-        byId.push_back(e.path());
-    std::sort(byId.begin(), byId.end());
-    for (const auto& link : byId) {
+    for (const auto& link : sortedEntries(dev / "serial" / "by-id")) {
         const auto name = link.filename().string();
         std::string note;
         // A Maestro shows two ports: interface 00 takes commands, 02 is its TTL serial line.
@@ -191,13 +198,7 @@ std::vector<std::string> listSerialPorts(const std::filesystem::path& dev) {
         const auto target = std::filesystem::canonical(link, ec);
         out.push_back(link.string() + " -> " + (ec ? "?" : target.string()) + note);
     }
-    std::vector<std::filesystem::path> ttys;
-    for (const auto& e : std::filesystem::directory_iterator(dev, ec)) {
-        const auto name = e.path().filename().string();
-        if (name.starts_with("ttyACM") || name.starts_with("ttyUSB")) ttys.push_back(e.path());
-    }
-    std::sort(ttys.begin(), ttys.end());
-    for (const auto& t : ttys) out.push_back(t.string());
+    for (const auto& t : sortedEntries(dev, {"ttyACM", "ttyUSB"})) out.push_back(t.string());
     return out;
 }
 

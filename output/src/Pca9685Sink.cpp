@@ -54,12 +54,11 @@ Pca9685Sink::Pca9685Sink(const Puppet& puppet, unsigned bus, unsigned address, I
           boardName(bus, address), std::move(log)),
       bus_(bus),
       address_(address),
-      opener_(open ? std::move(open)
-                   : [](unsigned b, unsigned a) { return openI2cDevice(b, a); }),
+      opener_(open ? std::move(open) : [](unsigned b, unsigned a) { return openI2cDevice(b, a); }),
       sent_(channels_.size(), -1) {
     if (!channels_.empty())  // (the puppet checks that a board's channels agree)
-        prescale_ = prescale(channels_.front().config->oscillatorHz,
-                             channels_.front().config->frequencyHz);
+        prescale_ =
+            prescale(channels_.front().config->oscillatorHz, channels_.front().config->frequencyHz);
 }
 
 Pca9685Sink::~Pca9685Sink() {
@@ -78,7 +77,8 @@ void Pca9685Sink::open() {
                                  " (wrong address? a PCA9685 is at 0x40 unless its A0-A5 pads are "
                                  "bridged; `lipsync devices` shows what answers)");
     // PRE_SCALE can be written only while the oscillator sleeps (7.3.1.1, 7.3.5).
-    const std::uint8_t awake = static_cast<std::uint8_t>((mode1 & ~(kRestart | kSleep)) | kAutoIncrement);
+    const std::uint8_t awake =
+        static_cast<std::uint8_t>((mode1 & ~(kRestart | kSleep)) | kAutoIncrement);
     const std::uint8_t sleep[] = {kMode1, static_cast<std::uint8_t>(awake | kSleep)};
     const std::uint8_t scale[] = {kPreScale, prescale_};
     const std::uint8_t mode2[] = {kMode2, kOutDrv};
@@ -106,13 +106,13 @@ bool Pca9685Sink::send(std::span<const ActuatorCommand> commands) {
     for (std::size_t k = 0; k < channels_.size(); ++k) {
         const auto& [index, config] = channels_[k];
         const auto& c = commands[index];
-        const int off = c.active ? counts(servoPulseUs(*config, c.value), config->oscillatorHz,
-                                          prescale_)
-                                 : kFullOff;
+        const int off =
+            c.active ? counts(servoPulseUs(*config, c.value), config->oscillatorHz, prescale_)
+                     : kFullOff;
         if (off == sent_[k]) continue;
         // ON at count 0, OFF after the pulse: LEDn_ON_L, ON_H, OFF_L, OFF_H (7.3.3).
-        const std::uint8_t led[] = {static_cast<std::uint8_t>(kLed0OnL + 4 * config->channel), 0,
-                                    0, static_cast<std::uint8_t>(off & 0xff),
+        const std::uint8_t led[] = {static_cast<std::uint8_t>(kLed0OnL + 4 * config->channel), 0, 0,
+                                    static_cast<std::uint8_t>(off & 0xff),
                                     static_cast<std::uint8_t>(off >> 8)};
         if (!device_->write(led)) return false;
         sent_[k] = off;

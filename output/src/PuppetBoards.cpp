@@ -49,13 +49,15 @@ void readMaestro(const TomlTable& t, ActuatorConfig& a) {
     if (a.port.empty()) t.fail("port", "empty: a serial port such as /dev/ttyACM0");
     a.channel = integer(t, "channel", 0, 0, 23, "must be 0 .. 23");
     if (t.has("frequency"))
-        t.fail("frequency", "a Maestro's pulse period is set on the board (Maestro Control Center)");
+        t.fail("frequency",
+               "a Maestro's pulse period is set on the board (Maestro Control Center)");
     if (t.has("device"))
         a.maestroDevice = static_cast<int>(integer(
             t, "device", 12, 0, 127, "must be 0 .. 127 (the board's Pololu-protocol number)"));
     const auto baud = t.optInteger("baud").value_or(115200);
     static const std::set<std::int64_t> kBauds{9600, 19200, 38400, 57600, 115200, 230400};
-    if (!kBauds.contains(baud)) t.fail("baud", "must be 9600, 19200, 38400, 57600, 115200 or 230400");
+    if (!kBauds.contains(baud))
+        t.fail("baud", "must be 9600, 19200, 38400, 57600, 115200 or 230400");
     a.baud = static_cast<unsigned>(baud);
     a.rampSeconds = t.optNumber("ramp").value_or(0);
     if (!(a.rampSeconds >= 0 && a.rampSeconds <= 10)) t.fail("ramp", "must be 0 .. 10 s");
@@ -133,7 +135,8 @@ void checkBoardChannels(const Puppet& p) {
             a.backend != Backend::Pwm)
             continue;
         const auto board = where(a);
-        const auto [first, fresh] = used.emplace(board + " channel " + std::to_string(a.channel), &a);
+        const auto [first, fresh] =
+            used.emplace(board + " channel " + std::to_string(a.channel), &a);
         if (!fresh)
             throw InputError(p.source.string(), a.line,
                              board + " channel " + std::to_string(a.channel) +
@@ -151,15 +154,15 @@ void checkBoardChannels(const Puppet& p) {
         if (!none && (other->second->frequencyHz != a.frequencyHz ||
                       other->second->oscillatorHz != a.oscillatorHz))
             throw InputError(p.source.string(), a.line,
-                             board + ": every channel of one board runs at one frequency and "
-                                     "oscillator (see actuator '" +
+                             board +
+                                 ": every channel of one board runs at one frequency and "
+                                 "oscillator (see actuator '" +
                                  other->second->name + "')");
     }
 }
 
 void describeBoardAddress(std::ostream& out, const ActuatorConfig& a) {
-    if (a.backend == Backend::Pca9685 || a.backend == Backend::Maestro ||
-        a.backend == Backend::Pwm)
+    if (a.backend == Backend::Pca9685 || a.backend == Backend::Maestro || a.backend == Backend::Pwm)
         out << " " << where(a) << " channel " << a.channel
             << (a.backend == Backend::Maestro ? "; pulse period set on the board" : "");
 }

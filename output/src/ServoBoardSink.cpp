@@ -44,7 +44,9 @@ void ServoBoardSink::write(double time, std::span<const ActuatorCommand> command
     connected_ = false;
     lastTry_ = time;
     lastWhy_ = "gone";
-    if (log_) log_(where_ + ": gone (write failed); looking for it every second, the other outputs go on");
+    if (log_)
+        log_(where_ +
+             ": gone (write failed); looking for it every second, the other outputs go on");
 }
 
 void addServoBoardSinks(PuppetDriver& driver, const Puppet& puppet, Log log,

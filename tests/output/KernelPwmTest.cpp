@@ -21,8 +21,8 @@ long long readValue(const std::filesystem::path& file) {
 class FakePwmTree {
   public:
     explicit FakePwmTree(int channels) {
-        root_ = std::filesystem::temp_directory_path() /
-                ("lipsyncd_pwm_" + std::to_string(::getpid()));
+        root_ =
+            std::filesystem::temp_directory_path() / ("lipsyncd_pwm_" + std::to_string(::getpid()));
         std::filesystem::remove_all(root_);
         std::filesystem::create_directories(chip());
         std::ofstream(chip() / "npwm") << channels << "\n";
@@ -145,14 +145,43 @@ TEST(KernelPwm, AMissingChipOrChannelIsNamedWithThePuppetLine) {
           {tree.root(), 5, "channel 5: the chip has 2 channels"}}) {
         const auto puppet = pwmPuppet(channel);
         std::vector<std::string> log;
-        output::KernelPwmSink sink(puppet, 0, root, [&](const std::string& m) { log.push_back(m); });
+        output::KernelPwmSink sink(puppet, 0, root,
+                                   [&](const std::string& m) { log.push_back(m); });
         const output::ActuatorCommand c[1] = {{0.5, true, false}};
         sink.write(0, c);
         EXPECT_FALSE(sink.connected());
         ASSERT_EQ(log.size(), 1u);
-        EXPECT_NE(log[0].find(puppet.source.string() + ":2: PWM chip"), std::string::npos) << log[0];
+        EXPECT_NE(log[0].find(puppet.source.string() + ":2: PWM chip"), std::string::npos)
+            << log[0];
         EXPECT_NE(log[0].find(why), std::string::npos) << log[0];
     }
+}
+
+TEST(DeviceListing, ChipsPortsAndBusesAreListedWithWhatToCallThem) {
+    FakePwmTree tree(2);
+    EXPECT_EQ(output::listPwmChips(tree.root()),
+              std::vector<std::string>{"pwmchip0: 2 channels (chip = 0)"});
+    const auto dev = tree.root() / "dev";  // a fake /dev
+    std::filesystem::create_directories(dev / "serial" / "by-id");
+    std::ofstream(dev / "ttyACM0");
+    std::ofstream(dev / "ttyACM1");
+    std::ofstream(dev / "i2c-1");
+    const std::string maestro =
+        "usb-Pololu_Corporation_Pololu_Micro_Maestro_6-Servo_Controller_0012";
+    std::filesystem::create_symlink("../../ttyACM0",
+                                    dev / "serial" / "by-id" / (maestro + "-if00"));
+    std::filesystem::create_symlink("../../ttyACM1",
+                                    dev / "serial" / "by-id" / (maestro + "-if02"));
+    const auto ports = output::listSerialPorts(dev);
+    ASSERT_EQ(ports.size(), 4u);
+    EXPECT_NE(ports[0].find("-if00 -> " + (dev / "ttyACM0").string()), std::string::npos)
+        << ports[0];
+    EXPECT_NE(ports[0].find("Maestro command port"), std::string::npos) << ports[0];
+    EXPECT_NE(ports[1].find("Maestro TTL port"), std::string::npos) << ports[1];
+    EXPECT_EQ(ports[2], (dev / "ttyACM0").string());
+    const auto buses = output::listI2cBuses(dev);
+    ASSERT_EQ(buses.size(), 1u);  // a plain file: nothing answers on it
+    EXPECT_NE(buses[0].find((dev / "i2c-1").string()), std::string::npos) << buses[0];
 }
 
 }  // namespace

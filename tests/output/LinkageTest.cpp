@@ -37,9 +37,10 @@ TEST(Linkage, TheShippedJawOpensLinearlyInTheCommandedValue) {
     const auto& l = *jaw.linkage;
     for (double value = jaw.min; value <= jaw.max; value += 2.5) {
         // The pulse the backend sends, back to the horn angle, forwards to the jaw.
-        const double share = (output::servoPulseUs(jaw, value) - jaw.pulseMinUs) /
-                             (jaw.pulseMaxUs - jaw.pulseMinUs);
-        const double horn = l.hornAtPulseMinDeg + share * (l.hornAtPulseMaxDeg - l.hornAtPulseMinDeg);
+        const double share =
+            (output::servoPulseUs(jaw, value) - jaw.pulseMinUs) / (jaw.pulseMaxUs - jaw.pulseMinUs);
+        const double horn =
+            l.hornAtPulseMinDeg + share * (l.hornAtPulseMaxDeg - l.hornAtPulseMinDeg);
         EXPECT_NEAR(jawOpening(l, horn, value), value, 0.05) << "at " << value << "°";
     }
     // Not a straight line in the servo: equal jaw steps take unequal pulse steps.
@@ -73,12 +74,11 @@ TEST(Linkage, AnUnreachableRangeIsRefusedSayingWhy) {
         return std::string("solved");
     };
     EXPECT_NE(whyNot(l, 120).find("cannot reach"), std::string::npos);  // past a dead point
-    l.rod = 20;  // cannot span the pivots
+    l.rod = 20;                                                         // cannot span the pivots
     EXPECT_NE(whyNot(l, 25).find("pushrod cannot join"), std::string::npos) << whyNot(l, 25);
     l = parallelLinkage();
     l.hornAtPulseMinDeg = 0;  // a servo that turns only 0 .. 45°
-    EXPECT_NE(whyNot(l, 25).find("outside the servo's travel"), std::string::npos)
-        << whyNot(l, 25);
+    EXPECT_NE(whyNot(l, 25).find("outside the servo's travel"), std::string::npos) << whyNot(l, 25);
 }
 
 std::string errorOf(const std::string& body) {

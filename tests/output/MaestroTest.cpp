@@ -37,7 +37,8 @@ class Pty {
     std::vector<std::uint8_t> drain() {
         std::vector<std::uint8_t> out;
         std::uint8_t buf[4096];
-        for (ssize_t n; (n = ::read(master_, buf, sizeof buf)) > 0;) out.insert(out.end(), buf, buf + n);
+        for (ssize_t n; (n = ::read(master_, buf, sizeof buf)) > 0;)
+            out.insert(out.end(), buf, buf + n);
         return out;
     }
 
@@ -95,7 +96,8 @@ unsigned quarterUs(const output::ActuatorConfig& a, double value) {
 
 TEST(Maestro, TheShippedJawSendsCompactTargetsThatFollowItWithinLimitsAndEndAtRest) {
     Pty pty;
-    const auto puppet = output::Puppet::load(writePuppet("maestro", shippedMaestroJaw(pty.slave())));
+    const auto puppet =
+        output::Puppet::load(writePuppet("maestro", shippedMaestroJaw(pty.slave())));
     const auto& jaw = puppet.actuators[0];
     output::PuppetDriver driver(puppet, std::vector<std::string>{"open", "wide", "pbm"});
     driver.addSink(std::make_unique<output::MaestroSink>(puppet, pty.slave()));
@@ -140,7 +142,7 @@ TEST(Maestro, TheShippedJawSendsCompactTargetsThatFollowItWithinLimitsAndEndAtRe
         EXPECT_LE(target, hi);
     }
     EXPECT_GT(*std::max_element(targets.begin(), targets.end()), (lo + hi) / 2);  // it moved
-    EXPECT_EQ(targets.back(), quarterUs(jaw, jaw.rest));  // rest last
+    EXPECT_EQ(targets.back(), quarterUs(jaw, jaw.rest));                          // rest last
 }
 
 output::Puppet twoChannelPuppet(const std::string& port, const std::string& extra) {
@@ -200,8 +202,8 @@ TEST(Maestro, ThePololuProtocolNamesTheDevice) {
 }
 
 TEST(Maestro, APortThatClosesIsReopenedWhenItIsBackWhileTheOthersGoOn) {
-    const auto link = std::filesystem::temp_directory_path() /
-                      ("lipsyncd_maestro_" + std::to_string(::getpid()));
+    const auto link =
+        std::filesystem::temp_directory_path() / ("lipsyncd_maestro_" + std::to_string(::getpid()));
     auto first = std::make_unique<Pty>();
     std::filesystem::remove(link);
     std::filesystem::create_symlink(first->slave(), link);
@@ -250,12 +252,12 @@ TEST(Maestro, APortThatClosesIsReopenedWhenItIsBackWhileTheOthersGoOn) {
 }
 
 TEST(Maestro, APortThatIsNotATtyOrNotThereIsNamedWithThePuppetLine) {
-    const auto file = std::filesystem::temp_directory_path() /
-                      ("lipsyncd_notatty_" + std::to_string(::getpid()));
+    const auto file =
+        std::filesystem::temp_directory_path() / ("lipsyncd_notatty_" + std::to_string(::getpid()));
     std::ofstream(file) << "";
-    for (const auto& [port, why] : {std::pair<std::string, std::string>{file.string(),
-                                                                        "not a serial port (a tty)"},
-                                    {"/dev/ttyACM97", "no such port"}}) {
+    for (const auto& [port, why] :
+         {std::pair<std::string, std::string>{file.string(), "not a serial port (a tty)"},
+          {"/dev/ttyACM97", "no such port"}}) {
         const auto puppet = twoChannelPuppet(port, "");
         std::vector<std::string> log;
         output::MaestroSink sink(puppet, port, [&](const std::string& m) { log.push_back(m); });
@@ -281,8 +283,8 @@ TEST(Maestro, APortThatIsNotATtyOrNotThereIsNamedWithThePuppetLine) {
 }
 
 TEST(MaestroDeathTest, APortTheUserMayNotOpenSaysWhichGroup) {
-    const auto file = std::filesystem::temp_directory_path() /
-                      ("lipsyncd_noperm_" + std::to_string(::getpid()));
+    const auto file =
+        std::filesystem::temp_directory_path() / ("lipsyncd_noperm_" + std::to_string(::getpid()));
     std::ofstream(file) << "";
     std::filesystem::permissions(file, std::filesystem::perms::none);
     const auto puppet = twoChannelPuppet(file.string(), "");

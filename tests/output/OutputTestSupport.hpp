@@ -65,8 +65,8 @@ class FakeHidDevice : public output::HidDevice {
 // ALL_LED registers; register auto-increment only when AI is set. It answers only when
 // `present`.
 struct FakePca9685 {
-    static constexpr std::uint8_t kMode1 = 0x00, kPreScale = 0xfe, kSleep = 0x10,
-                                  kRestart = 0x80, kAutoIncrement = 0x20;
+    static constexpr std::uint8_t kMode1 = 0x00, kPreScale = 0xfe, kSleep = 0x10, kRestart = 0x80,
+                                  kAutoIncrement = 0x20;
     std::array<std::uint8_t, 256> reg{};
     bool present = true;
     std::vector<std::uint8_t> mode1Writes;  // every value written to MODE1, in order

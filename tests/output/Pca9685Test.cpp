@@ -58,8 +58,8 @@ TEST(Pca9685, ThePrescalerIsSetAsleepAndTheBoardWokenAndRestarted) {
     EXPECT_EQ(chip.reg[FakePca9685::kPreScale], 121);
     EXPECT_EQ(chip.prescaleWritesLost, 0);
     ASSERT_GE(chip.mode1Writes.size(), 3u);
-    EXPECT_TRUE(chip.mode1Writes[0] & FakePca9685::kSleep);  // first: to sleep
-    EXPECT_FALSE(chip.mode1Writes[1] & FakePca9685::kSleep);  // then awake
+    EXPECT_TRUE(chip.mode1Writes[0] & FakePca9685::kSleep);    // first: to sleep
+    EXPECT_FALSE(chip.mode1Writes[1] & FakePca9685::kSleep);   // then awake
     EXPECT_TRUE(chip.mode1Writes[2] & FakePca9685::kRestart);  // channels were running: restart
     EXPECT_FALSE(chip.sleeping());
     EXPECT_FALSE(chip.reg[FakePca9685::kMode1] & FakePca9685::kRestart);  // restart done
@@ -109,7 +109,7 @@ TEST(Pca9685, CountsFollowTheJawWithinItsPulsesOnlyChangesAreWrittenRestThenFull
         ASSERT_LE(counts[i], hi) << i;
         if (i > 0) ASSERT_LE(std::abs(counts[i] - counts[i - 1]), 11) << i;
     }
-    EXPECT_EQ(*std::max_element(counts.begin(), counts.end()), hi);  // it did open fully
+    EXPECT_EQ(*std::max_element(counts.begin(), counts.end()), hi);       // it did open fully
     for (int ch = 0; ch < 16; ++ch) EXPECT_TRUE(chip.fullOff(ch)) << ch;  // stopped: all off
 }
 
@@ -171,7 +171,8 @@ TEST(Pca9685, ABoardThatVanishesIsSetUpAgainWhenItIsBack) {
     EXPECT_NE(log[1].find("connected"), std::string::npos);
     EXPECT_EQ(chip.reg[FakePca9685::kPreScale], 121);
     EXPECT_FALSE(chip.sleeping());
-    EXPECT_EQ(chip.off(3), output::Pca9685Sink::counts(1100 + 800 * (0.1 + 0.299) / 0.9, 25e6, 121));
+    EXPECT_EQ(chip.off(3),
+              output::Pca9685Sink::counts(1100 + 800 * (0.1 + 0.299) / 0.9, 25e6, 121));
 }
 
 TEST(Pca9685, RealI2cErrorsSayWhatToDo) {
@@ -187,7 +188,8 @@ TEST(Pca9685, RealI2cErrorsSayWhatToDo) {
         },
         std::runtime_error);
     // A file that is not an I2C bus.
-    const auto dir = std::filesystem::temp_directory_path() / ("lipsyncd_i2c_" + std::to_string(::getpid()));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("lipsyncd_i2c_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "i2c-1") << "";
     try {
@@ -200,8 +202,8 @@ TEST(Pca9685, RealI2cErrorsSayWhatToDo) {
 }
 
 TEST(Pca9685DeathTest, ABusTheUserMayNotOpenSaysWhichGroup) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("lipsyncd_i2cperm_" + std::to_string(::getpid()));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("lipsyncd_i2cperm_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "i2c-1") << "";
     std::filesystem::permissions(dir / "i2c-1", std::filesystem::perms::none);

@@ -453,9 +453,9 @@ class KernelPwmSink : public ServoBoardSink {
     void close() override;
 
     std::filesystem::path chipDir_;
-    std::vector<int> dutyFd_;                // per channel, open while connected
-    std::vector<std::int64_t> sent_;         // per channel: last duty (ns), -1: none
-    std::vector<bool> exported_;             // we exported it: unexport on close
+    std::vector<int> dutyFd_;         // per channel, open while connected
+    std::vector<std::int64_t> sent_;  // per channel: last duty (ns), -1: none
+    std::vector<bool> exported_;      // we exported it: unexport on close
 };
 // "pwmchip0: 2 channels" lines.
 std::vector<std::string> listPwmChips(const std::filesystem::path& root = "/sys/class/pwm");
