@@ -169,13 +169,7 @@ channel = 5
 gains = { open = 1.0 }
 min = 0.0
 max = 1.0
-[[actuator]]
-name = "led"
-backend = "virtual"
-gains = { open = 1.0 }
-min = 0.0
-max = 1.0
-)"));
+)" + kVirtualActuator));
 }
 
 TEST(Maestro, ThePololuProtocolNamesTheDevice) {

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <lipsyncd/output.hpp>
 #include <mutex>
+#include <string>
 
 namespace lipsyncd::test {
 
@@ -18,6 +19,15 @@ inline std::filesystem::path writePuppet(const std::string& name, const std::str
     std::ofstream(path) << toml;
     return path;
 }
+
+// An actuator on no hardware: the output that must keep going when a board fails.
+inline const std::string kVirtualActuator = R"([[actuator]]
+name = "virtual"
+backend = "virtual"
+gains = { open = 1.0 }
+min = 0.0
+max = 1.0
+)";
 
 // For "permission denied" tests, whoever runs them: root gives up its rights (to nobody) in
 // the death-test child; anyone else is refused a file with no permissions anyway.

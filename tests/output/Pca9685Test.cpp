@@ -26,13 +26,7 @@ min = 0.0
 max = 0.9
 slew = 6.0
 idle_after = 0.5
-[[actuator]]
-name = "lip"
-backend = "virtual"
-gains = { open = 1.0 }
-min = 0.0
-max = 1.0
-)"));
+)" + kVirtualActuator));
 }
 
 output::I2cOpener opener(FakePca9685& chip, int* opens = nullptr) {
