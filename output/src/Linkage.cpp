@@ -116,6 +116,8 @@ std::vector<LinkageRow> solveLinkage(const Linkage& l, double min, double max, s
 }
 
 double servoPulseUs(const ActuatorConfig& a, double value) {
+    // (The channel never hands on a non-finite value; should one arrive, it means rest.)
+    if (!std::isfinite(value)) value = a.rest;
     const double share = std::clamp((value - a.min) / (a.max - a.min), 0.0, 1.0);
     if (!a.linkage || a.linkage->table.size() < 2)
         return a.pulseMinUs + share * (a.pulseMaxUs - a.pulseMinUs);

@@ -62,6 +62,22 @@ output::Linkage parallelLinkage() {
     return l;
 }
 
+TEST(Linkage, PulsesNeverLeaveTheServosLimitsWhateverTheValue) {
+    for (const char* name : {"maestro-jaw", "pwm-jaw"}) {
+        const auto puppet = output::Puppet::named(name);
+        const auto& jaw = puppet.actuators[0];
+        const double lo =
+            std::min(output::servoPulseUs(jaw, jaw.min), output::servoPulseUs(jaw, jaw.max));
+        const double hi =
+            std::max(output::servoPulseUs(jaw, jaw.min), output::servoPulseUs(jaw, jaw.max));
+        for (const double v : {-1e9, jaw.min - 1, jaw.max + 1, 1e300, HUGE_VAL, -HUGE_VAL}) {
+            EXPECT_GE(output::servoPulseUs(jaw, v), lo) << name << " " << v;
+            EXPECT_LE(output::servoPulseUs(jaw, v), hi) << name << " " << v;
+        }
+        EXPECT_EQ(output::servoPulseUs(jaw, NAN), output::servoPulseUs(jaw, jaw.rest)) << name;
+    }
+}
+
 TEST(Linkage, AnUnreachableRangeIsRefusedSayingWhy) {
     auto l = parallelLinkage();
     EXPECT_NO_THROW(output::solveLinkage(l, 0, 25));

@@ -105,7 +105,8 @@ struct ActuatorConfig {
 };
 
 // The pulse width for a servo-type actuator's value: linear from min..max to
-// pulse_min_us..pulse_max_us, or through its linkage's table. No allocation.
+// pulse_min_us..pulse_max_us, or through its linkage's table; never outside the pulses (a
+// value out of range is clamped, a non-finite one is rest). No allocation.
 double servoPulseUs(const ActuatorConfig& actuator, double value);
 
 enum class HidEncoding { U8, U16LE };
