@@ -101,7 +101,9 @@ TEST(Pca9685, CountsFollowTheJawWithinItsPulsesOnlyChangesAreWrittenRestThenFull
     for (std::size_t i = 0; i < counts.size(); ++i) {
         ASSERT_GE(counts[i], lo) << i;
         ASSERT_LE(counts[i], hi) << i;
-        if (i > 0) ASSERT_LE(std::abs(counts[i] - counts[i - 1]), 11) << i;
+        if (i > 0) {
+            ASSERT_LE(std::abs(counts[i] - counts[i - 1]), 11) << i;
+        }
     }
     EXPECT_EQ(*std::max_element(counts.begin(), counts.end()), hi);       // it did open fully
     for (int ch = 0; ch < 16; ++ch) EXPECT_TRUE(chip.fullOff(ch)) << ch;  // stopped: all off

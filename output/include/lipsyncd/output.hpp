@@ -249,7 +249,7 @@ class ServoPwm {
     ServoPwm(const ServoPwm&) = delete;
     ServoPwm& operator=(const ServoPwm&) = delete;
     void set(std::size_t servo, double value, bool active);  // lock-free (atomics)
-    void setPulse(std::size_t servo, double pulseUs, bool active);
+    void setPulse(std::size_t servo, double pulseUs, bool active);  // (through a linkage)
     void runPeriods(int periods);  // for tests and benchmarks: run the loop inline
     void start();                  // the real-time thread
     bool realtime() const { return realtime_; }
@@ -352,11 +352,12 @@ class ServoBoardSink : public CommandSink {
     virtual void open() = 0;
     virtual bool send(std::span<const ActuatorCommand> commands) = 0;
     virtual void close() = 0;
-    void connect(double time);  // open(), or log why not and try again later
 
     std::vector<Channel> channels_;
 
   private:
+    void connect(double time);  // open(), or log why not and try again later
+
     std::string where_;  // "FILE:LINE: PCA9685 on ..."
     Log log_;
     bool connected_ = false;
