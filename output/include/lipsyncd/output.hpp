@@ -248,7 +248,7 @@ class ServoPwm {
     ~ServoPwm();
     ServoPwm(const ServoPwm&) = delete;
     ServoPwm& operator=(const ServoPwm&) = delete;
-    void set(std::size_t servo, double value, bool active);  // lock-free (atomics)
+    void set(std::size_t servo, double value, bool active);         // lock-free (atomics)
     void setPulse(std::size_t servo, double pulseUs, bool active);  // (through a linkage)
     void runPeriods(int periods);  // for tests and benchmarks: run the loop inline
     void start();                  // the real-time thread
