@@ -171,6 +171,34 @@ TEST(Pca9685, ABoardThatVanishesIsSetUpAgainWhenItIsBack) {
               output::Pca9685Sink::counts(1100 + 800 * (0.1 + 0.299) / 0.9, 25e6, 121));
 }
 
+TEST(Pca9685, AMissingBusIsNamedWithThePuppetLineAndTheOthersGoOn) {
+    auto text = R"(name = "pca"
+[[actuator]]
+name = "jaw"
+backend = "pca9685"
+bus = 99
+gains = { open = 1.0 }
+min = 0.0
+max = 1.0
+)" + kVirtualActuator;
+    const auto puppet = output::Puppet::load(writePuppet("pca99", text));
+    std::vector<std::string> log;
+    output::PuppetDriver driver(puppet, std::vector<std::string>{"open"});
+    output::addServoBoardSinks(driver, puppet, [&](const std::string& m) { log.push_back(m); });
+    std::ostringstream recorded;
+    output::RecorderSink recorder(recorded, puppet, output::RecorderSink::Format::Csv);
+    driver.addSink(recorder);
+    const float w[1] = {0.5f};
+    for (int i = 0; i < 50; ++i) driver.update(0.01 * i, w);
+    const auto rows = recorded.str();
+    EXPECT_EQ(std::count(rows.begin(), rows.end(), '\n'), 1 + 2 * 50);
+    ASSERT_EQ(log.size(), 1u);
+    EXPECT_NE(log[0].find(puppet.source.string() + ":2: PCA9685 on /dev/i2c-99 at 0x40: no I2C "
+                                                   "bus /dev/i2c-99"),
+              std::string::npos)
+        << log[0];
+}
+
 TEST(Pca9685, RealI2cErrorsSayWhatToDo) {
     EXPECT_THROW(
         {
