@@ -170,8 +170,10 @@ function startDrag(svg, pose, index, event) {
   event.target.setPointerCapture(event.pointerId);
   event.target.addEventListener('pointermove', moveDrag);
   event.target.addEventListener('pointerup', endDrag, { once: true });
+  // The circle holds the pointer capture: mark it, never redraw it away mid-drag.
+  for (const c of $('curves').querySelectorAll('circle.selected')) c.classList.remove('selected');
+  event.target.classList.add('selected');
   showPoint();
-  redrawPose(pose);
 }
 
 function moveDrag(event) {
@@ -466,7 +468,7 @@ function drawMouth(s) {
 async function start() {
   app.info = await api('GET', '/api/bigrams');
   $('file').textContent = app.info.character
-    ? 'character ' + app.info.character + ' on ' + app.info.base
+    ? 'character ' + app.info.character.split('/').pop() + ' on ' + app.info.base
     : app.info.base + ' (no character file: saving is off)';
   $('save').disabled = !app.info.character;
   buildGrid();
