@@ -197,7 +197,18 @@ ApiResponse EditorApi::preview(const ApiRequest& request) {
             return error(400, "voice: an espeak-ng voice name such as \"en-us+f2\"");
         voice = body["voice"].get<std::string>();
     }
-    return reply(200, renderPreview(*speech_, text, voice, draft_, settings_.runtime));
+    // The runtime's steps after the stitch can be switched off, as `animate --no-...` does.
+    auto runtime = settings_.runtime;
+    const std::pair<const char*, bool*> steps[] = {{"smoothing", &runtime.smoothing},
+                                                   {"constraints", &runtime.constraints},
+                                                   {"speed_limits", &runtime.speedLimits}};
+    for (const auto& [key, flag] : steps)
+        if (body.contains(key)) {
+            if (!body[key].is_boolean())
+                return error(400, std::string(key) + ": expected true or false");
+            *flag = body[key].get<bool>();
+        }
+    return reply(200, renderPreview(*speech_, text, voice, draft_, runtime));
 }
 
 ApiResponse EditorApi::save() {

@@ -327,7 +327,12 @@ async function save() {
 async function preview(event) {
   event.preventDefault();
   setStatus('speaking\u2026');
-  const p = await api('POST', '/api/preview', { text: $('sentence').value });
+  const p = await api('POST', '/api/preview', {
+    text: $('sentence').value,
+    smoothing: $('step-smoothing').checked,
+    constraints: $('step-constraints').checked,
+    speed_limits: $('step-speed').checked,
+  });
   app.preview = p;
   app.used = new Set(p.pairs);
   paintGrid();

@@ -119,7 +119,7 @@ TEST(EditorApi, TheBigramListHasEveryPairAndThePoseSetsPoses) {
     }
 }
 
-TEST(EditorApi, SaveWritesOnlyTheCharactersBigramsAndAnimatePlaysThem) {
+TEST(EditorApi, SaveWritesOnlyTheCharactersBigramsAsAFileThatLoads) {
     const auto dir = scratchDir("editor_save");
     const auto file = dir / "crab.json";
     {
@@ -182,6 +182,28 @@ TEST(EditorApi, PreviewSpeaksTheSentenceWithItsScheduleWeightsAndAudio) {
     EXPECT_GT(p["duration"].get<double>(), 0.3);
 }
 
+double mostOpen(const json& preview) {
+    const auto poses = preview["weights"]["poses"].get<std::vector<std::string>>();
+    const auto at = std::find(poses.begin(), poses.end(), "open") - poses.begin();
+    double most = 0;
+    for (const auto& v : preview["weights"]["values"][at]) most = std::max(most, v.get<double>());
+    return most;
+}
+
+TEST(EditorApi, PreviewPlaysTheUnsavedCurves) {
+    const auto dir = scratchDir("editor_preview_edit");
+    Editor e(dir / "crab.json");
+    const std::string say = R"({"text": "What fun", "constraints": false})";
+    const auto before = mostOpen(body(e.call("POST", "/api/preview", say)));
+    auto curves = body(e.call("GET", "/api/bigrams/f/ah"))["poses"];
+    for (auto& point : curves["open"])
+        if (point[0] > 0.6 && point[0] < 0.8) point[1] = 1.0;
+    ASSERT_EQ(e.call("PUT", "/api/bigrams/f/ah", json{{"poses", curves}}.dump()).status, 200);
+    const auto after = mostOpen(body(e.call("POST", "/api/preview", say)));
+    EXPECT_GT(after, before + 0.15);
+    EXPECT_FALSE(std::filesystem::exists(e.character));
+}
+
 TEST(EditorApi, PreviewRejectsWhatItCannotDoClearly) {
     const auto dir = scratchDir("editor_preview_bad");
     Editor e(dir / "crab.json");
@@ -191,6 +213,8 @@ TEST(EditorApi, PreviewRejectsWhatItCannotDoClearly) {
     const auto wav = e.call("POST", "/api/preview", R"({"wav": "/etc/passwd"})");
     EXPECT_EQ(wav.status, 400);
     EXPECT_NE(errorOf(wav).find("aligner"), std::string::npos);
+    EXPECT_EQ(e.call("POST", "/api/preview", R"({"text": "hi", "constraints": "no"})").status,
+              400);
     EXPECT_EQ(e.call("GET", "/api/preview").status, 405);
 }
 

@@ -124,6 +124,7 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
 
     // Type a sentence and preview it: the schedule, the curves, the audio, the mouth.
     web.type("#sentence", kSentence);
+    web.click("#step-constraints");  // see the raised point (the README says why)
     web.click("#preview");
     ASSERT_TRUE(waitFor(
         [&] { return web.script("return document.body.dataset.preview") == "ready"; }, 20))
