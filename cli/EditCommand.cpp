@@ -58,8 +58,7 @@ void runEdit(const EditOptions& o) {
                   << ", not only this machine: anyone with the address can edit and save\n";
     std::cout << "lipsync edit: " << server.url() << '\n'
               << "lipsync edit: "
-              << (o.character.empty() ? "no --character: saving is off"
-                                      : "saves to " + o.character)
+              << (o.character.empty() ? "no --character: saving is off" : "saves to " + o.character)
               << "; Ctrl-C stops" << std::endl;
     if (!o.noOpen) openInBrowser(server.url());
     std::thread watcher([&] {

@@ -37,8 +37,12 @@ std::string baseReference(const std::string& baseCurves, const std::filesystem::
 }
 
 // Saved with three decimals, as the curve-set writer does: what the page shows is what is saved.
-float rounded(float v) { return static_cast<float>(std::round(static_cast<double>(v) * 1000) / 1000); }
-double asSaved(float v) { return std::round(static_cast<double>(v) * 1000) / 1000; }
+float rounded(float v) {
+    return static_cast<float>(std::round(static_cast<double>(v) * 1000) / 1000);
+}
+double asSaved(float v) {
+    return std::round(static_cast<double>(v) * 1000) / 1000;
+}
 
 std::string pairName(const PhonemeSet& phonemes, std::size_t a, std::size_t b) {
     return phonemes[a].name + "-" + phonemes[b].name;
@@ -47,9 +51,12 @@ std::string pairName(const PhonemeSet& phonemes, std::size_t a, std::size_t b) {
 
 std::string_view toString(BigramState state) {
     switch (state) {
-        case BigramState::generated: return "generated";
-        case BigramState::character: return "character";
-        case BigramState::edited: return "edited";
+        case BigramState::generated:
+            return "generated";
+        case BigramState::character:
+            return "character";
+        case BigramState::edited:
+            return "edited";
     }
     return "generated";
 }
@@ -193,7 +200,8 @@ std::size_t CharacterDraft::save() {
     } catch (const InputError& e) {
         std::filesystem::remove(saving);
         std::string what = e.what();
-        if (what.starts_with(saving.string())) what.replace(0, saving.string().size(), file_.string());
+        if (what.starts_with(saving.string()))
+            what.replace(0, saving.string().size(), file_.string());
         throw InputError(what + " (not saved)");
     }
     std::filesystem::rename(saving, file_);

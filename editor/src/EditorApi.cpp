@@ -18,7 +18,9 @@ constexpr double kFirstCentre = 0.25, kSecondCentre = 0.75;
 constexpr std::size_t kCurveSamples = 101;  // the smooth curve, for drawing
 constexpr std::size_t kMaxTextLength = 500;
 
-ApiResponse reply(int status, const ordered_json& body) { return {status, body.dump()}; }
+ApiResponse reply(int status, const ordered_json& body) {
+    return {status, body.dump()};
+}
 ApiResponse error(int status, const std::string& what) {
     return reply(status, ordered_json{{"error", what}});
 }
@@ -27,8 +29,7 @@ ApiResponse error(int status, const std::string& what) {
 bool sameToken(const std::string& a, const std::string& b) {
     if (a.size() != b.size()) return false;
     unsigned char diff = 0;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+    for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
     return diff == 0;
 }
 
@@ -98,8 +99,8 @@ ApiResponse EditorApi::route(const ApiRequest& request) {
         const auto& set = draft_.phonemes();
         for (const auto* name : {&parts[2], &parts[3]})
             if (!set.find(*name))
-                return error(404, "no phoneme class '" + *name + "' (classes: " +
-                                      classList(set) + ")");
+                return error(404,
+                             "no phoneme class '" + *name + "' (classes: " + classList(set) + ")");
         const auto a = *set.find(parts[2]), b = *set.find(parts[3]);
         if (m == "GET") return bigram(a, b);
         if (m == "PUT") return putBigram(a, b, request);
@@ -159,8 +160,7 @@ ApiResponse EditorApi::bigram(std::size_t first, std::size_t second) const {
     return reply(200, j);
 }
 
-ApiResponse EditorApi::putBigram(std::size_t first, std::size_t second,
-                                 const ApiRequest& request) {
+ApiResponse EditorApi::putBigram(std::size_t first, std::size_t second, const ApiRequest& request) {
     json body;
     try {
         body = parseBody(request.body);
@@ -169,9 +169,9 @@ ApiResponse EditorApi::putBigram(std::size_t first, std::size_t second,
     }
     if (!body.contains("poses") || !body["poses"].is_object())
         return error(400, "request body: expected {\"poses\": {\"POSE\": [[t, v], ...], ...}}");
-    draft_.replace(first, second, body["poses"].dump(),
-                   "PUT /api/bigrams/" + draft_.phonemes()[first].name + "/" +
-                       draft_.phonemes()[second].name);
+    draft_.replace(
+        first, second, body["poses"].dump(),
+        "PUT /api/bigrams/" + draft_.phonemes()[first].name + "/" + draft_.phonemes()[second].name);
     return bigram(first, second);
 }
 
@@ -183,8 +183,9 @@ ApiResponse EditorApi::preview(const ApiRequest& request) {
         return error(400, e.what());
     }
     if (body.contains("wav"))
-        return error(400, "previewing a recording needs the known-script aligner, which this "
-                          "build lacks: preview with {\"text\": ...}");
+        return error(400,
+                     "previewing a recording needs the known-script aligner, which this "
+                     "build lacks: preview with {\"text\": ...}");
     if (!body.contains("text") || !body["text"].is_string() ||
         body["text"].get<std::string>().empty())
         return error(400, "request body: expected {\"text\": \"a sentence\"}");

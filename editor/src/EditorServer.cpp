@@ -67,7 +67,11 @@ std::string EditorServer::url() const {
            "/?token=" + token_;
 }
 
-void EditorServer::run() { impl_->server.listen_after_bind(); }
-void EditorServer::stop() { impl_->server.stop(); }
+void EditorServer::run() {
+    impl_->server.listen_after_bind();
+}
+void EditorServer::stop() {
+    impl_->server.stop();
+}
 
 }  // namespace lipsyncd::editor

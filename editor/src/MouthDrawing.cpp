@@ -9,16 +9,17 @@ namespace lipsyncd::editor {
 
 namespace {
 // What editor.js draws; keep the two in step.
-constexpr std::array<const char*, 8> kParameters{
-    "jaw", "width", "round", "press", "bite", "tongue_up", "tongue_down", "tongue_back"};
+constexpr std::array<const char*, 8> kParameters{"jaw",  "width",     "round",       "press",
+                                                 "bite", "tongue_up", "tongue_down", "tongue_back"};
 
 std::vector<double> readAmounts(const TomlTable& table) {
     std::vector<double> out(kParameters.size(), 0.0);
     for (const auto& key : table.keys()) {
         const auto* it = std::find(kParameters.begin(), kParameters.end(), key);
         if (it == kParameters.end())
-            table.fail(key, "not a drawing parameter (jaw, width, round, press, bite, "
-                            "tongue_up, tongue_down, tongue_back)");
+            table.fail(key,
+                       "not a drawing parameter (jaw, width, round, press, bite, "
+                       "tongue_up, tongue_down, tongue_back)");
         const double v = table.getNumber(key);
         if (!(v >= -1 && v <= 1)) table.fail(key, "must be in [-1, 1]");
         out[static_cast<std::size_t>(it - kParameters.begin())] = v;

@@ -47,8 +47,9 @@ bool isVoiceName(const std::string& voice) {
            });
 }
 
-ordered_json renderPreview(EspeakSynthesizer& speech, const std::string& text, const std::string& voice,
-                           const CharacterDraft& draft, const lipsync::RuntimeConfig& runtime) {
+ordered_json renderPreview(EspeakSynthesizer& speech, const std::string& text,
+                           const std::string& voice, const CharacterDraft& draft,
+                           const lipsync::RuntimeConfig& runtime) {
     const auto spoken = speech.synthesize({text, voice});
     std::vector<std::string> warnings;
     const auto schedule = mapSchedule(spoken.phonemes, espeakMapForVoice(voice), &warnings);

@@ -13,8 +13,8 @@ bool isVoiceName(const std::string& voice);
 // {"schedule": [{start, end, phoneme}], "pairs": ["sil-f", ...], "weights": {"poses", "rate",
 //  "times", "values": [[per frame] per pose]}, "duration", "audio": "data:audio/wav;base64,...",
 //  "warnings": [...]}
-nlohmann::ordered_json renderPreview(EspeakSynthesizer& speech, const std::string& text, const std::string& voice,
-                                     const CharacterDraft& draft,
+nlohmann::ordered_json renderPreview(EspeakSynthesizer& speech, const std::string& text,
+                                     const std::string& voice, const CharacterDraft& draft,
                                      const lipsync::RuntimeConfig& runtime);
 
 // 16-bit mono PCM as a WAV file in a data: URI, for the page's <audio>.

@@ -36,13 +36,13 @@ std::string wavDataUri(std::span<const std::int16_t> samples, int sampleRate) {
     std::string wav = "RIFF";
     putLe(wav, 36 + dataBytes, 4);
     wav += "WAVEfmt ";
-    putLe(wav, 16, 4);                                        // fmt chunk size
-    putLe(wav, 1, 2);                                         // PCM
-    putLe(wav, 1, 2);                                         // mono
-    putLe(wav, static_cast<std::uint32_t>(sampleRate), 4);    // frames per second
+    putLe(wav, 16, 4);                                          // fmt chunk size
+    putLe(wav, 1, 2);                                           // PCM
+    putLe(wav, 1, 2);                                           // mono
+    putLe(wav, static_cast<std::uint32_t>(sampleRate), 4);      // frames per second
     putLe(wav, static_cast<std::uint32_t>(sampleRate) * 2, 4);  // bytes per second
-    putLe(wav, 2, 2);                                         // bytes per frame
-    putLe(wav, 16, 2);                                        // bits per sample
+    putLe(wav, 2, 2);                                           // bytes per frame
+    putLe(wav, 16, 2);                                          // bits per sample
     wav += "data";
     putLe(wav, dataBytes, 4);
     for (const auto s : samples) putLe(wav, static_cast<std::uint16_t>(s), 2);

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <fstream>
-
 #include <lipsyncd/editor.hpp>
 #include <nlohmann/json.hpp>
 
@@ -38,8 +37,12 @@ struct Editor {
     }
 };
 
-json body(const ApiResponse& r) { return json::parse(r.body); }
-std::string errorOf(const ApiResponse& r) { return body(r).value("error", ""); }
+json body(const ApiResponse& r) {
+    return json::parse(r.body);
+}
+std::string errorOf(const ApiResponse& r) {
+    return body(r).value("error", "");
+}
 
 const std::string kOpenPut = R"({"poses": {"open": [[0, 0], [0.4, 0.9], [1, 0]]}})";
 
@@ -213,8 +216,7 @@ TEST(EditorApi, PreviewRejectsWhatItCannotDoClearly) {
     const auto wav = e.call("POST", "/api/preview", R"({"wav": "/etc/passwd"})");
     EXPECT_EQ(wav.status, 400);
     EXPECT_NE(errorOf(wav).find("aligner"), std::string::npos);
-    EXPECT_EQ(e.call("POST", "/api/preview", R"({"text": "hi", "constraints": "no"})").status,
-              400);
+    EXPECT_EQ(e.call("POST", "/api/preview", R"({"text": "hi", "constraints": "no"})").status, 400);
     EXPECT_EQ(e.call("GET", "/api/preview").status, 405);
 }
 

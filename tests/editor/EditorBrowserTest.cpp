@@ -48,9 +48,8 @@ json chromeCapabilities(const std::filesystem::path& profile) {
               {"goog:chromeOptions",
                {{"binary", kChromium},
                 {"args",
-                 {"--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                  "--no-first-run", "--disable-background-networking",
-                  "--disable-component-update", "--disable-sync",
+                 {"--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
                   "--autoplay-policy=no-user-gesture-required", "--window-size=1380,1240",
                   "--user-data-dir=" + profile.string()}}}}}}};
 }
@@ -87,8 +86,8 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
     ASSERT_FALSE(url.empty()) << slurp(dir / "edit.err");
 
     const int driverPort = freePort();
-    ChildProcess driver({kChromedriver, "--port=" + std::to_string(driverPort)},
-                        dir / "driver.out", dir / "driver.err");
+    ChildProcess driver({kChromedriver, "--port=" + std::to_string(driverPort)}, dir / "driver.out",
+                        dir / "driver.err");
     WebDriver web(driverPort);
     ASSERT_TRUE(waitFor([&] { return web.up(); }, 20)) << slurp(dir / "driver.err");
     const auto failure = web.startSession(chromeCapabilities(dir / "profile"));
@@ -96,26 +95,31 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
 
     // Load the page and pick f–ah.
     web.go(url);
-    ASSERT_TRUE(waitFor([&] { return web.script("return document.body.dataset.ready") == "yes"; }, 20))
+    ASSERT_TRUE(
+        waitFor([&] { return web.script("return document.body.dataset.ready") == "yes"; }, 20))
         << web.script("return document.getElementById('error').textContent");
     web.click("#grid button[data-pair='f-ah']");
     const std::string point = "svg[data-pose='open'] circle[data-index='6']";
     ASSERT_TRUE(waitFor(
-        [&] { return web.script("return !!document.querySelector(arguments[0])", json::array({point})) == true; },
+        [&] {
+            return web.script("return !!document.querySelector(arguments[0])",
+                              json::array({point})) == true;
+        },
         10));
-    const auto valueBefore = web.script(
-        "return app.bigram.poses.open[6][1]").get<double>();
+    const auto valueBefore = web.script("return app.bigram.poses.open[6][1]").get<double>();
 
     // Drag that point of `open` up; the grid marks the bigram changed, not saved.
     web.drag(point, 0, -24);
     ASSERT_TRUE(waitFor(
         [&] {
-            return web.script("return document.querySelector(\"#grid button[data-pair='f-ah']\")"
-                              ".classList.contains('edited') && !app.sending") == true;
+            return web.script(
+                       "return document.querySelector(\"#grid button[data-pair='f-ah']\")"
+                       ".classList.contains('edited') && !app.sending") == true;
         },
         10))
-        << web.script("return JSON.stringify({error: document.getElementById('error').textContent,"
-                      " open: app.bigram.poses.open, dragging: !!app.drag})");
+        << web.script(
+               "return JSON.stringify({error: document.getElementById('error').textContent,"
+               " open: app.bigram.poses.open, dragging: !!app.drag})");
     const auto valueAfter = web.script("return app.bigram.poses.open[6][1]").get<double>();
     EXPECT_GT(valueAfter, valueBefore + 0.1);
     const auto shots = screenshotDir(dir);
@@ -126,12 +130,14 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
     web.type("#sentence", kSentence);
     web.click("#step-constraints");  // see the raised point (the README says why)
     web.click("#preview");
-    ASSERT_TRUE(waitFor(
-        [&] { return web.script("return document.body.dataset.preview") == "ready"; }, 20))
+    ASSERT_TRUE(
+        waitFor([&] { return web.script("return document.body.dataset.preview") == "ready"; }, 20))
         << web.script("return document.getElementById('error').textContent");
     EXPECT_TRUE(web.script("return document.querySelector(\"#grid button[data-pair='f-ah']\")"
                            ".classList.contains('used')") == true);
-    EXPECT_TRUE(waitFor([&] { return web.script("return document.getElementById('audio').duration > 0") == true; }, 10));
+    EXPECT_TRUE(waitFor(
+        [&] { return web.script("return document.getElementById('audio').duration > 0") == true; },
+        10));
     // The cursor in the pair's second phoneme, where `open` peaks: the mouth is drawn open.
     const auto middle = web.script(
         "const s = app.preview.schedule.find((x, i, all) => x.phoneme === 'ah' && i > 0"
@@ -139,9 +145,10 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
         " audio.pause(); audio.currentTime = (s.start + s.end) / 2; return audio.currentTime;");
     EXPECT_TRUE(waitFor(
         [&] {
-            return web.script("return Number(document.getElementById('cursor').getAttribute('x1'))"
-                              " === tlX(arguments[0])",
-                              json::array({middle})) == true;
+            return web.script(
+                       "return Number(document.getElementById('cursor').getAttribute('x1'))"
+                       " === tlX(arguments[0])",
+                       json::array({middle})) == true;
         },
         5));
     EXPECT_GT(web.script("return document.querySelectorAll('#mouth path').length").get<int>(), 2);

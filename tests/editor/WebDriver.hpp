@@ -86,11 +86,16 @@ inline std::string decodeBase64(const std::string& in) {
     int bits = 0;
     for (const char c : in) {
         int v = -1;
-        if (c >= 'A' && c <= 'Z') v = c - 'A';
-        else if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
-        else if (c >= '0' && c <= '9') v = c - '0' + 52;
-        else if (c == '+') v = 62;
-        else if (c == '/') v = 63;
+        if (c >= 'A' && c <= 'Z')
+            v = c - 'A';
+        else if (c >= 'a' && c <= 'z')
+            v = c - 'a' + 26;
+        else if (c >= '0' && c <= '9')
+            v = c - '0' + 52;
+        else if (c == '+')
+            v = 62;
+        else if (c == '/')
+            v = 63;
         if (v < 0) continue;
         buffer = (buffer << 6) | static_cast<unsigned>(v);
         bits += 6;
@@ -107,17 +112,15 @@ class WebDriver {
     using json = nlohmann::json;
     static constexpr const char* kElement = "element-6066-11e4-a52e-4f735466cecf";
 
-    explicit WebDriver(int port) : http_("127.0.0.1", port) {
-        http_.set_read_timeout(60, 0);
-    }
+    explicit WebDriver(int port) : http_("127.0.0.1", port) { http_.set_read_timeout(60, 0); }
     bool up() {
         const auto r = http_.Get("/status");
         return r && r->status == 200;
     }
     // Starts the browser; the error text when it cannot.
     std::string startSession(const json& capabilities) {
-        const auto r = http_.Post("/session", json{{"capabilities", capabilities}}.dump(),
-                                  "application/json");
+        const auto r =
+            http_.Post("/session", json{{"capabilities", capabilities}}.dump(), "application/json");
         if (!r) return "no answer from chromedriver";
         const auto j = json::parse(r->body, nullptr, false);
         if (r->status != 200 || j.is_discarded() || !j["value"].contains("sessionId"))
@@ -129,10 +132,11 @@ class WebDriver {
         if (!session_.empty()) http_.Delete("/session/" + session_);
     }
 
-    json call(const std::string& method, const std::string& path, const json& body = json::object()) {
+    json call(const std::string& method, const std::string& path,
+              const json& body = json::object()) {
         const auto url = "/session/" + session_ + path;
-        const auto r = method == "GET" ? http_.Get(url)
-                                       : http_.Post(url, body.dump(), "application/json");
+        const auto r =
+            method == "GET" ? http_.Get(url) : http_.Post(url, body.dump(), "application/json");
         if (!r) throw std::runtime_error("webdriver: no answer to " + path);
         auto j = json::parse(r->body);
         if (r->status != 200) throw std::runtime_error("webdriver " + path + ": " + r->body);
@@ -157,9 +161,15 @@ class WebDriver {
         const json steps = json::array({
             {{"type", "pointerMove"}, {"duration", 0}, {"origin", origin}, {"x", 0}, {"y", 0}},
             {{"type", "pointerDown"}, {"button", 0}},
-            {{"type", "pointerMove"}, {"duration", 150}, {"origin", "pointer"}, {"x", dx / 2},
+            {{"type", "pointerMove"},
+             {"duration", 150},
+             {"origin", "pointer"},
+             {"x", dx / 2},
              {"y", dy / 2}},
-            {{"type", "pointerMove"}, {"duration", 150}, {"origin", "pointer"}, {"x", dx - dx / 2},
+            {{"type", "pointerMove"},
+             {"duration", 150},
+             {"origin", "pointer"},
+             {"x", dx - dx / 2},
              {"y", dy - dy / 2}},
             {{"type", "pointerUp"}, {"button", 0}},
         });

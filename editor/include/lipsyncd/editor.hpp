@@ -77,8 +77,8 @@ class CharacterDraft {
 // neutral value plus the sum over poses of weight × the pose's amount. Data, so a new pose
 // moves the drawing once it has a line in the file; poses without one do not move it.
 struct MouthDrawing {
-    std::vector<std::string> parameters;              // the drawing's vocabulary
-    std::vector<double> neutral;                      // per parameter
+    std::vector<std::string> parameters;                             // the drawing's vocabulary
+    std::vector<double> neutral;                                     // per parameter
     std::vector<std::pair<std::string, std::vector<double>>> poses;  // pose → per parameter
     // config/editor/mouth.toml (or a path); errors name the file, line and key. Poses that
     // `poseSet` lacks are left out (a pose set may drop one the file draws).
