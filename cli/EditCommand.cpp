@@ -37,6 +37,17 @@ void openInBrowser(const std::string& url) {
 }
 
 void runEdit(const EditOptions& o) {
+    // SIGINT and SIGTERM stop the server from a thread of their own (sigwait), not a handler;
+    // blocked before any thread starts (espeak-ng and the server start their own).
+    sigset_t stopSignals;
+    sigemptyset(&stopSignals);
+    sigaddset(&stopSignals, SIGINT);
+    sigaddset(&stopSignals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+
+    if (!o.character.empty() &&
+        !std::filesystem::is_directory(std::filesystem::absolute(o.character).parent_path()))
+        throw InputError(o.character + ": no such folder to save the character in");
     const auto& phonemes = PhonemeSet::named(o.phonemes);
     auto poses = lipsync::PoseSet::named(o.poses);
     auto mouth = editor::MouthDrawing::load(findDataFile("editor/mouth.toml"), poses);
@@ -44,13 +55,6 @@ void runEdit(const EditOptions& o) {
     EspeakSynthesizer speech;
     editor::EditorApi api(std::move(draft), std::move(mouth), editor::randomToken(), speech,
                           {o.voice, lipsync::RuntimeConfig{}});
-
-    // SIGINT and SIGTERM stop the server from a thread of their own (sigwait), not a handler.
-    sigset_t stopSignals;
-    sigemptyset(&stopSignals);
-    sigaddset(&stopSignals, SIGINT);
-    sigaddset(&stopSignals, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
 
     editor::EditorServer server(api, o.server);
     if (!isLoopback(o.server.bind))

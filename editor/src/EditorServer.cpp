@@ -1,6 +1,7 @@
 // cpp-httplib around the API and the built-in page. The page and its two files are the only
 // things served besides the API; a URL never names a file on disk.
 #include <httplib.h>
+#include <sys/socket.h>
 
 #include <lipsyncd/editor.hpp>
 
@@ -42,6 +43,12 @@ EditorServer::EditorServer(EditorApi& api, const ServerOptions& options)
                            {"Content-Security-Policy",
                             "default-src 'self'; media-src 'self' data:; img-src 'self' data:"}});
     s.set_payload_max_length(kMaxBody);
+    // cpp-httplib's default adds SO_REUSEPORT, which lets a second editor share the port and
+    // take half the requests: only SO_REUSEADDR, so a busy port is an error.
+    s.set_socket_options([](int sock) {
+        int yes = 1;
+        ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     const auto toApi = [&api](const httplib::Request& req, httplib::Response& res) {
         serveApi(api, req, res);
     };

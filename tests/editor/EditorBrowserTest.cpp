@@ -50,8 +50,8 @@ json chromeCapabilities(const std::filesystem::path& profile) {
                 {"args",
                  {"--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                  "--autoplay-policy=no-user-gesture-required", "--window-size=1380,1240",
-                  "--user-data-dir=" + profile.string()}}}}}}};
+                  "--autoplay-policy=no-user-gesture-required", "--disable-dev-shm-usage",
+                  "--window-size=1380,1240", "--user-data-dir=" + profile.string()}}}}}}};
 }
 
 std::filesystem::path screenshotDir(const std::filesystem::path& fallback) {
