@@ -1,4 +1,4 @@
-// lipsync edit: the curve editor, a local web application (paper 000, section 2.1, figure 3).
+// lipsync edit: the curve editor, a local web application (Xu et al. 2013, section 2.1, figure 3).
 // A process of its own, so the service (lipsyncd) never needs the network.
 #include <signal.h>
 #include <spawn.h>

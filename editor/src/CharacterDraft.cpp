@@ -1,4 +1,4 @@
-// The curves being edited. Paper 000 (section 2.1): characters share the base set and replace
+// The curves being edited. Xu et al. 2013, section 2.1: characters share the base set and replace
 // single bigrams, so a save writes only the character's own bigrams; the base is never touched.
 #include <algorithm>
 #include <cmath>

@@ -13,7 +13,7 @@ using nlohmann::json;
 using nlohmann::ordered_json;
 
 // The runtime warps normalised time 0..½ onto the first phoneme and ½..1 onto the second
-// (paper 000, section 2.2.1), so their centres sit here.
+// (Xu et al. 2013, section 2.2.1), so their centres sit here.
 constexpr double kFirstCentre = 0.25, kSecondCentre = 0.75;
 constexpr std::size_t kCurveSamples = 101;  // the smooth curve, for drawing
 constexpr std::size_t kMaxTextLength = 500;

@@ -252,7 +252,9 @@ async function send() {
     } while (app.pending);
   } catch (e) {
     showError(e);
+    const selected = app.selected;
     await openPair(app.bigram.first, app.bigram.second).catch(showError);  // the server's truth
+    app.selected = selected;
   } finally {
     app.sending = false;
   }
@@ -273,7 +275,11 @@ function showPoint() {
   const s = app.selected;
   const ok = s && app.bigram && app.bigram.poses[s.pose] && app.bigram.poses[s.pose][s.index];
   for (const id of ['point-time', 'point-value', 'point-set']) $(id).disabled = !ok;
-  if (!ok) { $('point-name').textContent = 'no point selected'; return; }
+  if (!ok) {
+    $('point-name').textContent = 'no point selected';
+    $('point-time').value = $('point-value').value = '';
+    return;
+  }
   const [t, v] = app.bigram.poses[s.pose][s.index];
   $('point-name').textContent = s.pose + ' point ' + s.index;
   $('point-time').value = t;

@@ -126,6 +126,37 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
     std::filesystem::create_directories(shots);
     writeFile(shots / "editor-curves.png", web.screenshotPng());
 
+    // Undo puts the base's curve back, redo the drag; a typed point the loader refuses is
+    // refused with the loader's message and changes nothing.
+    const auto pairState = [&] {
+        return web.script(
+            "return document.querySelector(\"#grid button[data-pair='f-ah']\")"
+            ".classList.contains('edited') ? 'edited' : 'not edited'");
+    };
+    const auto settled = [&](const char* state, double value) {
+        return waitFor(
+            [&] {
+                return pairState() == state && web.script("return app.sending") == false &&
+                       web.script("return app.bigram.poses.open[6][1]") == value;
+            },
+            10);
+    };
+    web.click("#undo");
+    EXPECT_TRUE(settled("not edited", valueBefore));
+    web.click("#redo");
+    EXPECT_TRUE(settled("edited", valueAfter));
+    web.click(point);  // select it for numeric entry
+    web.type("#point-time", "1.5");
+    web.click("#point-set");
+    EXPECT_TRUE(waitFor(
+        [&] {
+            return web.script("return document.getElementById('error').textContent")
+                       .get<std::string>()
+                       .find("bigrams.f-ah.open[6]: time must be in [0, 1]") != std::string::npos;
+        },
+        10));
+    EXPECT_TRUE(settled("edited", valueAfter));
+
     // Type a sentence and preview it: the schedule, the curves, the audio, the mouth.
     web.type("#sentence", kSentence);
     web.click("#step-constraints");  // see the raised point (the README says why)

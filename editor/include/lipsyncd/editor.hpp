@@ -1,4 +1,4 @@
-// editor: `lipsync edit`, the curve editor of paper 000 (section 2.1, figure 3) as a local web
+// editor: `lipsync edit`, the curve editor of Xu et al. 2013 (section 2.1, figure 3) as a local web
 // application. Animators pick a phone bigram, drag the control points of each pose's curve and
 // at once hear and see a sentence that uses the pair; save writes a character file holding only
 // the bigrams they changed.
