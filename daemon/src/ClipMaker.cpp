@@ -1,6 +1,8 @@
 // Requests made ready to play: a file is decoded and analysed offline (ahead of playback, so a
 // replayed file has no recognition latency); text is spoken by espeak-ng with its exact
 // schedule. Either way the pose weights are computed before the first sample is heard.
+#include <array>
+#include <cmath>
 #include <lipsyncd/daemon.hpp>
 #include <lipsyncd/dsp.hpp>
 #include <lipsyncd/lipsync.hpp>
@@ -25,11 +27,14 @@ struct ClipMaker::Impl {
                                         : dsp::TemplateSet::load(findDataFile(c.templates))),
           poseNames(poses.names()) {}
 
-    PoseTrack animate(const PhonemeSchedule& s) const {
+    // The mouth for a schedule, opened as wide as the speech (`samples`) is loud.
+    PoseTrack animate(const PhonemeSchedule& s, std::span<const float> samples, int rate) const {
         lipsync::RuntimeConfig rc;
         rc.outputRate = config.outputRateHz;
-        return config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc)
-                                          : lipsync::animate(s, curves, poses, rc);
+        auto track = config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc)
+                                                : lipsync::animate(s, curves, poses, rc);
+        lipsync::shapeByLoudness(poses, dsp::measureLevels(samples, rate), track);
+        return track;
     }
 };
 
@@ -52,7 +57,8 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
     clip.samples = audio.samples;
     clip.rate = audio.sampleRate;
     const auto result = dsp::analyzeFile(file, impl_->templates, PhonemeSet::common(), {}, decode);
-    clip.weights = impl_->animate(result.schedule);
+    const auto voice = channel >= 0 ? dsp::readAudioFile(file, decode) : audio;
+    clip.weights = impl_->animate(result.schedule, voice.samples, voice.sampleRate);
     return clip;
 }
 
@@ -64,7 +70,8 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;
     for (auto s : speech.samples) clip.samples.push_back(static_cast<float>(s) / 32768.0f);
-    clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr));
+    clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr),
+                                  clip.samples, clip.rate);
     return clip;
 }
 
@@ -80,23 +87,43 @@ class StreamingLive : public ClipMaker::Live {
     StreamingLive(const dsp::TemplateSet& templates, const lipsync::BigramCurveSet& curves,
                   const lipsync::PoseSet& poses, double outputRate, int rate)
         : analyzer_(templates, PhonemeSet::common(), rate),
-          runtime_(curves, poses, 0, config(outputRate)) {
+          runtime_(curves, poses, 0, config(outputRate)),
+          shaper_(poses) {
         analyzer_.onSegment([this](const PhonemeSegment& s) { runtime_.push(s, *out_); });
         // The newest frame's class stands for the phoneme still open (the segmenter has not
         // closed it yet): the mouth starts moving without waiting for the phoneme to end.
         analyzer_.onFrame([this](const dsp::StreamingAnalyzer::Frame& f) {
             openPhoneme_ = PhonemeSet::common()[static_cast<std::size_t>(f.label.phoneme)].name;
             openUntil_ = f.label.time;
+            levels_[frames_++ % levels_.size()] = {f.label.time, f.label.energyDb};
         });
     }
     void push(std::span<const float> samples, PoseTrack& out) override {
         out_ = &out;
         analyzer_.push(samples);
         if (!openPhoneme_.empty()) runtime_.preview(openPhoneme_, openUntil_, out);
+        shapeNewFrames(out);
     }
     double latencySeconds() const override { return analyzer_.latencySeconds(); }
 
   private:
+    // Louder speech opens wider: each new weight frame by the level of the audio frame nearest
+    // its time among the recent ones (a fixed ring: nothing allocates here).
+    void shapeNewFrames(PoseTrack& out) {
+        // The caller may clear the track between pushes: frames are told apart by their time.
+        const std::size_t poses = out.poses.size();
+        for (std::size_t f = 0; f < out.frames(); ++f) {
+            const double t = out.times[f];
+            if (t <= shapedUntil_) continue;
+            float db = -120;
+            double nearest = 1e9;
+            for (const auto& l : levels_)
+                if (std::abs(l.time - t) < nearest) nearest = std::abs(l.time - t), db = l.db;
+            shaper_.shape(db, t - shapedUntil_,
+                          std::span<float>(out.values).subspan(f * poses, poses));
+            shapedUntil_ = t;
+        }
+    }
     static lipsync::RuntimeConfig config(double rate) {
         lipsync::RuntimeConfig c;
         c.outputRate = rate;
@@ -104,9 +131,17 @@ class StreamingLive : public ClipMaker::Live {
     }
     dsp::StreamingAnalyzer analyzer_;
     lipsync::StreamingRuntime runtime_;
+    lipsync::LoudnessShaper shaper_;
     PoseTrack* out_ = nullptr;
     std::string openPhoneme_;
     double openUntil_ = 0;
+    struct Level {
+        double time = -1e9;
+        float db = -120;
+    };
+    std::array<Level, 32> levels_{};  // the last 320 ms of audio frames
+    std::size_t frames_ = 0;
+    double shapedUntil_ = -1e9;  // the last weight frame shaped
 };
 }  // namespace
 

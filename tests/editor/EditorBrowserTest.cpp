@@ -221,8 +221,8 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
         }
 
     // `lipsync animate --character` on the sentence plays the change. Without constraints: the
-    // shipped pose set caps `open` at 0.5 through its w–open and fv–open thresholds (0.5), so
-    // a point raised above 0.5 shows only where no constraint applies.
+    // shipped pose set's constraints on `open` (threshold 0.5) cap it at 0.5 even where the
+    // other pose is 0, so a point raised above 0.5 shows only where no constraint applies.
     const auto schedule = (dir / "what-fun.tsv").string();
     ASSERT_EQ(runLipsync({"say", kSentence, "--schedule", schedule}).exitCode, 0);
     const auto plain = runLipsync({"animate", "--schedule", schedule, "--no-constraints",
