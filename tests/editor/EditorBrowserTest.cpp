@@ -51,7 +51,7 @@ json chromeCapabilities(const std::filesystem::path& profile) {
                  {"--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync",
                   "--autoplay-policy=no-user-gesture-required", "--disable-dev-shm-usage",
-                  "--window-size=1380,1240", "--user-data-dir=" + profile.string()}}}}}}};
+                  "--window-size=1380,1320", "--user-data-dir=" + profile.string()}}}}}}};
 }
 
 std::filesystem::path screenshotDir(const std::filesystem::path& fallback) {
