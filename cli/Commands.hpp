@@ -16,5 +16,6 @@ void addCurvesCommand(CLI::App& app);
 void addPlotCommand(CLI::App& app);
 void addDriveCommands(CLI::App& app);  // drive, check, devices
 void addCtlCommand(CLI::App& app);
+void addEditCommand(CLI::App& app);
 
 }  // namespace lipsyncd::cli

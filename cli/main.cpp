@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
     addPlotCommand(app);
     addDriveCommands(app);
     addCtlCommand(app);
+    addEditCommand(app);
 
     try {
         app.parse(argc, argv);

@@ -175,6 +175,17 @@ void BigramCurveSet::applyOverrides(const std::filesystem::path& characterFile,
     name_ = j["name"];
 }
 
+void BigramCurveSet::applyBigramsJson(std::string_view bigramsJson, const std::string& source,
+                                      const PoseSet& poses, const PhonemeSet& phonemes) {
+    json j;
+    try {
+        j = json::parse(bigramsJson);
+    } catch (const json::parse_error& e) {
+        throw InputError(source + ": not valid JSON (" + e.what() + ")");
+    }
+    readBigrams(j, source, poses, phonemes, *this);
+}
+
 BigramCurveSet BigramCurveSet::named(const std::string& nameOrPath, const PoseSet& poses,
                                      const PhonemeSet& phonemes) {
     return load(findNamedDataFile(nameOrPath, "curves", ".json"), poses, phonemes);

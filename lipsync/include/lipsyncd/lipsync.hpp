@@ -20,6 +20,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -117,6 +118,12 @@ class BigramCurveSet {
     // Applies a character file's bigrams on top of this set.
     void applyOverrides(const std::filesystem::path& characterFile, const PoseSet& poses,
                         const PhonemeSet& phonemes = PhonemeSet::common());
+    // The same for bigrams already in memory, as JSON text in a character file's "bigrams"
+    // form ({"a-b": {pose: [[t, v], ...]}}), checked as load() checks a file; errors name
+    // `source` where load() names the file (the curve editor's requests). On an error some
+    // of the bigrams may be applied already: apply to a scratch set, then copy.
+    void applyBigramsJson(std::string_view bigramsJson, const std::string& source,
+                          const PoseSet& poses, const PhonemeSet& phonemes = PhonemeSet::common());
 
     const std::string& name() const { return name_; }
     std::string& description() { return description_; }

@@ -1,0 +1,52 @@
+// A WAV file in memory, base64-encoded into a data: URI: the page plays the preview's speech
+// without a second request or a file on disk.
+#include <array>
+#include <cstdint>
+
+#include "SpeechPreview.hpp"
+
+namespace lipsyncd::editor {
+
+namespace {
+void putLe(std::string& out, std::uint32_t v, int bytes) {
+    for (int i = 0; i < bytes; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+}
+
+// RFC 4648, section 4.
+std::string base64(const std::string& in) {
+    static constexpr char kDigits[] =
+        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((in.size() + 2) / 3 * 4);
+    for (std::size_t i = 0; i < in.size(); i += 3) {
+        std::uint32_t n = static_cast<unsigned char>(in[i]) << 16;
+        if (i + 1 < in.size()) n |= static_cast<unsigned char>(in[i + 1]) << 8;
+        if (i + 2 < in.size()) n |= static_cast<unsigned char>(in[i + 2]);
+        out.push_back(kDigits[(n >> 18) & 63]);
+        out.push_back(kDigits[(n >> 12) & 63]);
+        out.push_back(i + 1 < in.size() ? kDigits[(n >> 6) & 63] : '=');
+        out.push_back(i + 2 < in.size() ? kDigits[n & 63] : '=');
+    }
+    return out;
+}
+}  // namespace
+
+std::string wavDataUri(std::span<const std::int16_t> samples, int sampleRate) {
+    const auto dataBytes = static_cast<std::uint32_t>(samples.size() * 2);
+    std::string wav = "RIFF";
+    putLe(wav, 36 + dataBytes, 4);
+    wav += "WAVEfmt ";
+    putLe(wav, 16, 4);                                          // fmt chunk size
+    putLe(wav, 1, 2);                                           // PCM
+    putLe(wav, 1, 2);                                           // mono
+    putLe(wav, static_cast<std::uint32_t>(sampleRate), 4);      // frames per second
+    putLe(wav, static_cast<std::uint32_t>(sampleRate) * 2, 4);  // bytes per second
+    putLe(wav, 2, 2);                                           // bytes per frame
+    putLe(wav, 16, 2);                                          // bits per sample
+    wav += "data";
+    putLe(wav, dataBytes, 4);
+    for (const auto s : samples) putLe(wav, static_cast<std::uint16_t>(s), 2);
+    return "data:audio/wav;base64," + base64(wav);
+}
+
+}  // namespace lipsyncd::editor
