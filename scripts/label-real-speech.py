@@ -12,6 +12,8 @@ Labels:
   tool only (the product never depends on it). Each ARPAbet phone is a "word" of a JSGF grammar
   that spells the transcript (every dictionary pronunciation allowed, optional pauses), so the
   decoder's word times are phone times. Phones map to the common set by config/phonemes/arpabet.toml.
+- words known in Italian or Spanish (asterisk prompts): the same aligner, each word spelled in
+  the nearest English phones from espeak-ng's phonemisation (config/corpus/espeak-arpabet.toml).
 - festvox-ru: the voice's own time-aligned phone labels (lab/*.lab), mapped by
   config/phonemes/festvox-ru.toml.
 Items whose words are not in the dictionary, or that the aligner cannot fit, are skipped and
@@ -75,7 +77,8 @@ def asterisk_items(root, voice, lang):
             key = key.strip()
             audio = base / f"{key}.wav"
             if audio.exists() and "[" not in text:
-                yield key.replace("/", "_"), audio, words_of(text), None
+                words = words_of(text) if lang == "en" else ("espeak", lang, text.strip())
+                yield key.replace("/", "_"), audio, words, None
 
 
 def klettres_items(root, lang):
@@ -137,18 +140,47 @@ def load_dictionary():
     return prons
 
 
-def grammar(words, prons):
+def espeak_spelling(lang, text):
+    """Per word, the one pronunciation espeak-ng gives, in ARPAbet (config/corpus/espeak-arpabet.toml)."""
+    table = tomllib.loads((HERE / "config/corpus/espeak-arpabet.toml").read_text())["map"]
+    out = subprocess.run(["espeak-ng", "-q", "-x", "--sep= ", "-v", lang, text],
+                         capture_output=True, text=True, check=True).stdout
+    words = []
+    for word in re.split(r"\s{2,}|\n", out):
+        phones = []
+        for token in word.split():
+            token = re.sub(r"[',:;]", "", token)
+            if not token or token.startswith("_"):
+                continue
+            if token not in table:
+                return None  # a sound the table does not know: leave the prompt out
+            phones += table[token].split()
+        if phones:
+            words.append([phones])
+    return words
+
+
+def spelling(words, prons):
+    """Per word, its pronunciations (ARPAbet lists); None when a word cannot be spelled."""
+    if isinstance(words, tuple):
+        return espeak_spelling(words[1], words[2])
+    if not words or any(w not in prons for w in words):
+        return None
+    return [prons[w] for w in words]
+
+
+def grammar(spelled):
     """JSGF spelling the words phone by phone; every pronunciation allowed, pauses optional."""
     parts = []
-    for w in words:
-        alts = [" ".join("ph_" + p.lower() for p in pron) for pron in prons[w]]
+    for alternatives in spelled:
+        alts = [" ".join("ph_" + p.lower() for p in pron) for pron in alternatives]
         parts.append("(" + " | ".join(alts) + ")")
     body = " [sil] ".join(parts)
     return f"#JSGF V1.0;\ngrammar align;\npublic <s> = [sil] {body} [sil];\n"
 
 
-def align(wav, words, prons, work, phones):
-    (work / "g.jsgf").write_text(grammar(words, prons))
+def align(wav, spelled, work, phones):
+    (work / "g.jsgf").write_text(grammar(spelled))
     cmd = ["pocketsphinx_continuous", "-infile", str(wav), "-hmm", str(MODEL / "en-us"),
            "-dict", str(work / "ph.dict"), "-jsgf", str(work / "g.jsgf"), "-time", "yes",
            "-remove_silence", "no", "-fsgusefiller", "no", "-beam", "1e-80", "-pbeam", "1e-80", "-wbeam", "1e-60",
@@ -229,12 +261,13 @@ def main():
                 if words is not None:
                     if prons is None:
                         prons = load_dictionary()
-                    if not words or any(w not in prons for w in words):
+                    spelled = spelling(words, prons)
+                    if not spelled:
                         skipped += 1
                         continue
                 duration = convert(audio, wav)
                 if segments is None:
-                    segments = align(wav, words, prons, work, phones)
+                    segments = align(wav, spelled, work, phones)
                     if not any(s[2] != "sil" for s in segments):
                         wav.unlink()
                         skipped += 1
