@@ -50,9 +50,12 @@ struct FrontEndOptions {
         cmd.add_flag("!--no-decoder", decoder.enabled,
                      "Classify frame by frame (no Viterbi decoding over classes)");
         cmd.add_option("--lag", decoder.lagSeconds,
-                       "Decoder lag, seconds (negative: offline, decided from the whole input)")
-            ->check(CLI::Range(-1.0, 2.0))
+                       "Decoder lag, seconds: how long a frame waits for later frames")
+            ->check(CLI::Range(0.0, 2.0))
             ->capture_default_str();
+        cmd.add_flag_callback(
+            "--offline", [this] { decoder.lagSeconds = -1; },
+            "Decode offline: every frame decided from the whole input (files only)");
         cmd.add_option("--transitions", transitions,
                        "Class transition model (JSON; default: "
                        "config/decoder/english-transitions.json)");

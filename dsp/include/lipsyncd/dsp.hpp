@@ -371,7 +371,7 @@ class ViterbiDecoder {
     double hop_ = 0.01;
     int sil_ = 0;
     std::vector<float> score_, next_, emission_;
-    std::vector<float> exitScore_;  // per class: the score of its last state
+    std::vector<float> exitScore_;     // per class: the score of its last state
     std::vector<std::uint16_t> back_;  // [frame slot][state]: the state before
     std::vector<FrameLabel> pending_;  // labels not yet decided, oldest first
     std::size_t frames_ = 0, decided_ = 0;
