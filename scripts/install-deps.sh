@@ -11,6 +11,7 @@ packages=(
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev
+  sox libsox-fmt-base pocketsphinx pocketsphinx-en-us  # labelling real speech (tests, training)
 )
 
 missing=()
