@@ -47,14 +47,17 @@ void WholeFile16kHz(benchmark::State& state) {
     const auto file =
         test::writeAudio("bench16k.wav", audio, 16000, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
     const auto templates = dsp::TemplateSet::loadDefault();
+    dsp::FrontEndConfig config;  // Arg 1: Viterbi decoding (the default); 0: frame by frame
+    config.decoder.enabled = state.range(0) == 1;
+    state.SetLabel(config.decoder.enabled ? "decoder on" : "decoder off");
     for (auto _ : state) {
-        auto result = dsp::analyzeFile(file, templates, PhonemeSet::common());
+        auto result = dsp::analyzeFile(file, templates, PhonemeSet::common(), config);
         benchmark::DoNotOptimize(result.schedule.data());
     }
     state.counters["x_realtime"] = benchmark::Counter(
         static_cast<double>(audio.size()) / 16000, benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(WholeFile16kHz)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+BENCHMARK(WholeFile16kHz)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 void FrameAnalysis(benchmark::State& state) {
     dsp::AnalysisConfig config;
@@ -131,6 +134,26 @@ void Segment(benchmark::State& state) {
     }
 }
 BENCHMARK(Segment);
+
+// One frame through the Viterbi decoder at its default lag (cost per frame).
+void Decode(benchmark::State& state) {
+    const auto templates = dsp::TemplateSet::loadDefault();
+    const auto frames = featuresOf(speechAt(10000), templates.analysis);
+    dsp::FrameClassifier classifier(templates, PhonemeSet::common());
+    std::vector<dsp::FrameLabel> labels;
+    std::vector<std::vector<float>> distances;
+    for (const auto& f : frames) {
+        labels.push_back(classifier.classify(f));
+        distances.emplace_back(classifier.distances().begin(), classifier.distances().end());
+    }
+    dsp::ViterbiDecoder decoder(dsp::TransitionModel::loadDefault(), PhonemeSet::common(), 0.01);
+    std::size_t i = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(decoder.push(labels[i], distances[i]).size());
+        i = i + 1 < labels.size() ? i + 1 : 0;
+    }
+}
+BENCHMARK(Decode);
 
 long residentKiB() {
     std::ifstream statm("/proc/self/statm");

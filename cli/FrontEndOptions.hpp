@@ -14,6 +14,8 @@ struct FrontEndOptions {
     std::string rawSpec;
     std::string resampler = "medium";
     dsp::SegmenterConfig segmenter;
+    dsp::DecoderConfig decoder;
+    std::string transitions;  // empty: the shipped default
 
     void addTo(CLI::App& cmd) {
         cmd.add_option("--templates", templates,
@@ -39,6 +41,24 @@ struct FrontEndOptions {
         cmd.add_option("--min-silence", segmenter.minSilenceSeconds, "Shortest silence, seconds")
             ->check(CLI::Range(0.0, 0.5))
             ->capture_default_str();
+        addDecoderTo(cmd);
+    }
+
+    void addDecoderTo(CLI::App& cmd) {
+        // Viterbi over classes (dsp::ViterbiDecoder): the lag is how long a frame waits for
+        // the frames after it before its class is decided.
+        cmd.add_flag("!--no-decoder", decoder.enabled,
+                     "Classify frame by frame (no Viterbi decoding over classes)");
+        cmd.add_option("--lag", decoder.lagSeconds,
+                       "Decoder lag, seconds: how long a frame waits for later frames")
+            ->check(CLI::Range(0.0, 2.0))
+            ->capture_default_str();
+        cmd.add_flag_callback(
+            "--offline", [this] { decoder.lagSeconds = -1; },
+            "Decode offline: every frame decided from the whole input (files only)");
+        cmd.add_option("--transitions", transitions,
+                       "Class transition model (JSON; default: "
+                       "config/decoder/english-transitions.json)");
     }
 
     dsp::TemplateSet loadTemplates() const {
@@ -53,6 +73,9 @@ struct FrontEndOptions {
     dsp::FrontEndConfig config() const {
         dsp::FrontEndConfig c;
         c.segmenter = segmenter;
+        c.decoder = decoder;
+        if (decoder.enabled && !transitions.empty())
+            c.transitions = dsp::TransitionModel::load(findDataFile(transitions));
         if (resampler == "low") c.resamplerQuality = dsp::ResamplerQuality::Low;
         if (resampler == "high") c.resamplerQuality = dsp::ResamplerQuality::High;
         if (resampler == "veryhigh") c.resamplerQuality = dsp::ResamplerQuality::VeryHigh;

@@ -80,6 +80,10 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
     // Noise floor: follows quiet frames down at once, creeps up slowly during sound.
     const double dt = floorInitialised_ ? std::max(0.0, frame.time - lastTime_) : 0.0;
     lastTime_ = frame.time;
+    // A first frame quiet enough to be the room starts the floor; a loud one is speech already
+    // and leaves the floor where it starts.
+    if (!floorInitialised_ && frame.energyDb <= config_.maxStartFloorDb)
+        noiseFloorDb_ = frame.energyDb;
     floorInitialised_ = true;
     if (frame.energyDb < noiseFloorDb_)
         noiseFloorDb_ = frame.energyDb;

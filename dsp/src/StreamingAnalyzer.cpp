@@ -23,13 +23,22 @@ StreamingAnalyzer::StreamingAnalyzer(const TemplateSet& templates, const Phoneme
       frames_(config_.analysis, inputRate, config_.resamplerQuality),
       classifier_(templates_, set, config_.classifier),
       segmenter_(set, config_.analysis.hopSeconds, config_.segmenter) {
+    if (config_.decoder.enabled)
+        decoder_.emplace(
+            config_.transitions ? *config_.transitions : TransitionModel::loadDefault(), set,
+            config_.analysis.hopSeconds, config_.decoder);
     frame_.features = FrameAnalyzer(config_.analysis).makeFeatures();
     featureSink_ = [this](const FrameFeatures& f) { onFeatures(f); };
 }
 
 double StreamingAnalyzer::latencySeconds() const {
     return frames_.resamplerDelaySeconds() + config_.analysis.windowSeconds +
-           segmenter_.delaySeconds();
+           (decoder_ ? decoder_->delaySeconds() : 0.0) + segmenter_.delaySeconds();
+}
+
+void StreamingAnalyzer::segment(const FrameLabel& label) {
+    for (const auto& seg : segmenter_.push(label))
+        if (segmentSink_) segmentSink_(seg);
 }
 
 void StreamingAnalyzer::onFeatures(const FrameFeatures& features) {
@@ -38,8 +47,8 @@ void StreamingAnalyzer::onFeatures(const FrameFeatures& features) {
         frame_.features = features;
         frameSink_(frame_);
     }
-    for (const auto& seg : segmenter_.push(frame_.label))
-        if (segmentSink_) segmentSink_(seg);
+    if (!decoder_) return segment(frame_.label);
+    for (const auto& label : decoder_->push(frame_.label, classifier_.distances())) segment(label);
 }
 
 void StreamingAnalyzer::push(std::span<const float> samples) {
@@ -48,6 +57,8 @@ void StreamingAnalyzer::push(std::span<const float> samples) {
 
 void StreamingAnalyzer::finish() {
     frames_.finish(featureSink_);
+    if (decoder_)
+        for (const auto& label : decoder_->finish()) segment(label);
     for (const auto& seg : segmenter_.finish(frames_.endTime()))
         if (segmentSink_) segmentSink_(seg);
 }

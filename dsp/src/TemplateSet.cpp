@@ -4,27 +4,14 @@
 #include <lipsyncd/dsp.hpp>
 #include <nlohmann/json.hpp>
 
+#include "JsonField.hpp"
+
 namespace lipsyncd::dsp {
 
 namespace {
 using nlohmann::json;
 constexpr const char* kFormat = "lipsyncd-templates";
 constexpr int kVersion = 1;
-
-// Reads a member with a message naming the JSON path when it is missing or of the wrong type.
-template <typename T>
-T member(const json& j, const std::string& key, const std::string& path,
-         const std::string& source) {
-    if (!j.is_object() || !j.contains(key))
-        throw InputError(source, 0, "missing field '" + path + key + "'");
-    try {
-        return j.at(key).get<T>();
-    } catch (const json::exception&) {
-        throw InputError(source, 0,
-                         "field '" + path + key + "' has the wrong type (" +
-                             std::string(j.at(key).type_name()) + ")");
-    }
-}
 
 AnalysisConfig readAnalysis(const json& a, const std::string& source) {
     AnalysisConfig c;
@@ -126,21 +113,7 @@ void TemplateSet::validate(const std::string& source) const {
 
 TemplateSet TemplateSet::load(const std::filesystem::path& file) {
     const std::string source = file.string();
-    std::ifstream in(file);
-    if (!in) throw InputError(source + ": cannot open");
-    json j;
-    try {
-        j = json::parse(in);
-    } catch (const json::parse_error& e) {
-        throw InputError(source, 0, std::string("not valid JSON: ") + e.what());
-    }
-    if (member<std::string>(j, "format", "", source) != kFormat)
-        throw InputError(source, 0, std::string("field 'format' must be \"") + kFormat + "\"");
-    if (const int v = member<int>(j, "version", "", source); v != kVersion)
-        throw InputError(source, 0,
-                         "template format version " + std::to_string(v) +
-                             " is not supported (this build reads " + std::to_string(kVersion) +
-                             ")");
+    const json j = readDataDocument(file, kFormat, kVersion);
     TemplateSet t;
     t.description = j.value("description", "");
     t.analysis = readAnalysis(member<json>(j, "analysis", "", source), source);

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Fetches recordings of real people from Debian packages and labels them, for training and
+# evaluating the front end (the speakers and their train/dev split: config/corpus/real-speakers.txt).
+#
+#   scripts/fetch-real-speech.sh OUT_DIR                # every speaker: OUT_DIR/{train,dev}/SPEAKER/
+#   scripts/fetch-real-speech.sh OUT_DIR --subset 8     # the first 8 files of each speaker
+#   scripts/fetch-real-speech.sh OUT_DIR --split dev    # only the dev speakers
+#
+# Packages are fetched with `apt-get download` and unpacked with `dpkg -x` into a cache
+# ($REAL_SPEECH_CACHE, default build/real-speech-cache): no root needed, nothing installed, and
+# the audio never enters the repository. Labelling needs sox and, for the English word lists,
+# pocketsphinx + pocketsphinx-en-us (a development-time labeller; the product never uses it):
+# `apt-get install sox libsox-fmt-base pocketsphinx pocketsphinx-en-us`.
+# Exit codes: 0 done, 1 error, 2 usage, 77 the packages or tools cannot be had (tests skip).
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+out="${1:?usage: fetch-real-speech.sh OUT_DIR [--subset N] [--split train|dev]}"
+shift
+cache="${REAL_SPEECH_CACHE:-$here/build/real-speech-cache}"
+
+split=""
+for ((i = 1; i <= $#; i++)); do [ "${!i}" = --split ] && { j=$((i + 1)); split="${!j:-}"; }; done
+
+# The packages behind the speakers asked for (config/corpus/real-speakers.txt: SOURCE column).
+packages=()
+while read -r speaker kind source; do
+  case "$speaker" in ''|'#'*) continue ;; esac
+  [ -n "$split" ] && [ "$kind" != "$split" ] && continue
+  case "$source" in
+    asterisk:*) lang="${source##*:}"
+                packages+=("asterisk-core-sounds-$lang-wav" "asterisk-core-sounds-$lang") ;;
+    klettres:*) packages+=(klettres-data) ;;
+    ktuberling:*) packages+=(ktuberling-data) ;;
+    festvox-ru) packages+=(festvox-ru) ;;
+    *) echo "fetch-real-speech.sh: $speaker: unknown source '$source'" >&2; exit 1 ;;
+  esac
+done <"$here/config/corpus/real-speakers.txt"
+mapfile -t packages < <(printf '%s\n' "${packages[@]}" | sort -u)
+tools=(sox soxi pocketsphinx_continuous python3)
+
+unavailable() { echo "fetch-real-speech.sh: $*" >&2; exit 77; }
+
+for t in "${tools[@]}"; do
+  command -v "$t" >/dev/null ||
+    unavailable "$t not found (apt-get install sox libsox-fmt-base pocketsphinx pocketsphinx-en-us)"
+done
+[ -f /usr/share/pocketsphinx/model/en-us/cmudict-en-us.dict ] ||
+  unavailable "the pocketsphinx-en-us model is not installed (apt-get install pocketsphinx-en-us)"
+
+mkdir -p "$cache/debs" "$cache/root"
+for p in "${packages[@]}"; do
+  [ -e "$cache/root/.$p" ] && continue
+  ls "$cache/debs/${p}_"*.deb >/dev/null 2>&1 ||
+    (cd "$cache/debs" && apt-get download -q "$p" >/dev/null 2>&1) ||
+    unavailable "cannot download $p (apt-get download; is apt reachable and its lists updated?)"
+  dpkg -x "$cache/debs/${p}_"*.deb "$cache/root"
+  touch "$cache/root/.$p"
+done
+
+python3 "$here/scripts/label-real-speech.py" "$cache/root" "$out" "$@"

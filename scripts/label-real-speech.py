@@ -1,0 +1,281 @@
+#!/usr/bin/env python3
+"""Labels recordings of real people for training and evaluation (run by fetch-real-speech.sh).
+
+    label-real-speech.py ROOT OUT_DIR [--subset N] [--speakers a,b]
+
+ROOT is where the Debian packages were unpacked (dpkg -x). The speakers, their split and their
+source are read from config/corpus/real-speakers.txt. Every item becomes
+OUT_DIR/SPLIT/SPEAKER/NAME.wav (16 kHz mono 16-bit, by sox) and NAME.lab (common-set labels).
+
+Labels:
+- words known (English): forced alignment with pocketsphinx and its en-us model, a development
+  tool only (the product never depends on it). Each ARPAbet phone is a "word" of a JSGF grammar
+  that spells the transcript (every dictionary pronunciation allowed, optional pauses), so the
+  decoder's word times are phone times. Phones map to the common set by config/phonemes/arpabet.toml.
+- words known in Italian or Spanish (asterisk prompts): the same aligner, each word spelled in
+  the nearest English phones from espeak-ng's phonemisation (config/corpus/espeak-arpabet.toml).
+- festvox-ru: the voice's own time-aligned phone labels (lab/*.lab), mapped by
+  config/phonemes/festvox-ru.toml.
+Items whose words are not in the dictionary, or that the aligner cannot fit, are skipped and
+counted. Reproducible: same packages, same tools, same files.
+"""
+import argparse
+import gzip
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import tomllib
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent.parent
+MODEL = Path("/usr/share/pocketsphinx/model/en-us")
+ARPABET = ("AA AE AH AO AW AY B CH D DH EH ER EY F G HH IH IY JH K L M N NG OW OY P R S SH T TH "
+           "UH UW V W Y Z ZH").split()
+
+
+def log(msg):
+    print(f"label-real-speech: {msg}", file=sys.stderr)
+
+
+def load_map(name):
+    doc = tomllib.loads((HERE / "config/phonemes" / f"{name}.toml").read_text())
+    table = dict(doc.get("map", {}))
+    table.update(doc.get("nearest", {}))
+    return {k.lower(): v for k, v in table.items()} if not doc.get("case_sensitive") else table
+
+
+def load_speakers(path):
+    speakers = []
+    for n, line in enumerate(path.read_text().splitlines(), 1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        fields = line.split()
+        if len(fields) != 3 or fields[1] not in ("train", "dev"):
+            sys.exit(f"{path}:{n}: expected 'SPEAKER train|dev SOURCE', got '{line}'")
+        speakers.append(tuple(fields))
+    return speakers
+
+
+# --- sources: each yields (name, audio path, words or None, ready labels or None) -------------
+
+def words_of(text):
+    text = re.sub(r"\[[^\]]*\]", " ", text.lower())
+    return re.findall(r"[a-z']+", text.replace("-", " "))
+
+
+def asterisk_items(root, voice, lang):
+    base = root / "usr/share/asterisk/sounds" / voice
+    txt = root / f"usr/share/doc/asterisk-core-sounds-{lang}/core-sounds-{lang}.txt.gz"
+    with gzip.open(txt, "rt", encoding="utf-8-sig") as f:
+        for line in f:
+            if line.startswith(";") or ":" not in line:
+                continue
+            key, text = line.split(":", 1)
+            key = key.strip()
+            audio = base / f"{key}.wav"
+            if audio.exists() and "[" not in text:
+                words = words_of(text) if lang == "en" else ("espeak", lang, text.strip())
+                yield key.replace("/", "_"), audio, words, None
+
+
+def klettres_items(root, lang):
+    base = root / "usr/share/klettres" / lang
+    for sub in ("alpha", "syllab"):
+        for audio in sorted((base / sub).glob("*.ogg")):
+            yield f"{sub}_{audio.stem}", audio, [audio.stem.lower()], None
+
+
+def ktuberling_items(root, lang):
+    words = {}
+    table = HERE / "config/corpus/ktuberling-en-words.txt"
+    for line in table.read_text().splitlines():
+        if line.strip() and not line.startswith("#"):
+            key, text = line.split(":", 1)
+            words[key.strip()] = text.split()
+    for audio in sorted((root / "usr/share/ktuberling/sounds" / lang).glob("*.ogg")):
+        if audio.stem in words:
+            yield audio.stem, audio, words[audio.stem], None
+
+
+def festvox_ru_items(root):
+    base = root / "usr/share/festival/voices/russian/msu_ru_nsh_clunits"
+    phones = load_map("festvox-ru")
+    for lab in sorted((base / "lab").glob("*.lab")):
+        segments, start = [], 0.0
+        for line in lab.read_text().splitlines():
+            fields = line.split()
+            if len(fields) != 3:
+                continue
+            end = float(fields[0])
+            if fields[2] not in phones:
+                sys.exit(f"{lab}: phone '{fields[2]}' is not in config/phonemes/festvox-ru.toml")
+            segments.append((start, end, phones[fields[2]]))
+            start = end
+        yield lab.stem, base / "wav" / f"{lab.stem}.wav", None, segments
+
+
+def items_of(root, source):
+    kind, *args = source.split(":")
+    if kind == "asterisk":
+        return asterisk_items(root, *args)
+    if kind == "klettres":
+        return klettres_items(root, *args)
+    if kind == "ktuberling":
+        return ktuberling_items(root, *args)
+    if kind == "festvox-ru":
+        return festvox_ru_items(root)
+    sys.exit(f"config/corpus/real-speakers.txt: unknown source '{source}'")
+
+
+# --- forced alignment with pocketsphinx ------------------------------------------------------
+
+def load_dictionary():
+    prons = {}
+    for line in (MODEL / "cmudict-en-us.dict").read_text(errors="replace").splitlines():
+        word, *phones = line.split()
+        prons.setdefault(re.sub(r"\(\d+\)$", "", word), []).append(phones)
+    return prons
+
+
+def espeak_spelling(lang, text):
+    """Per word, the one pronunciation espeak-ng gives, in ARPAbet (config/corpus/espeak-arpabet.toml)."""
+    table = tomllib.loads((HERE / "config/corpus/espeak-arpabet.toml").read_text())["map"]
+    out = subprocess.run(["espeak-ng", "-q", "-x", "--sep= ", "-v", lang, text],
+                         capture_output=True, text=True, check=True).stdout
+    words = []
+    for word in re.split(r"\s{2,}|\n", out):
+        phones = []
+        for token in word.split():
+            token = re.sub(r"[',:;]", "", token)
+            if not token or token.startswith("_"):
+                continue
+            if token not in table:
+                return None  # a sound the table does not know: leave the prompt out
+            phones += table[token].split()
+        if phones:
+            words.append([phones])
+    return words
+
+
+def spelling(words, prons):
+    """Per word, its pronunciations (ARPAbet lists); None when a word cannot be spelled."""
+    if isinstance(words, tuple):
+        return espeak_spelling(words[1], words[2])
+    if not words or any(w not in prons for w in words):
+        return None
+    return [prons[w] for w in words]
+
+
+def grammar(spelled):
+    """JSGF spelling the words phone by phone; every pronunciation allowed, pauses optional."""
+    parts = []
+    for alternatives in spelled:
+        alts = [" ".join("ph_" + p.lower() for p in pron) for pron in alternatives]
+        parts.append("(" + " | ".join(alts) + ")")
+    body = " [sil] ".join(parts)
+    return f"#JSGF V1.0;\ngrammar align;\npublic <s> = [sil] {body} [sil];\n"
+
+
+def align(wav, spelled, work, phones):
+    (work / "g.jsgf").write_text(grammar(spelled))
+    cmd = ["pocketsphinx_continuous", "-infile", str(wav), "-hmm", str(MODEL / "en-us"),
+           "-dict", str(work / "ph.dict"), "-jsgf", str(work / "g.jsgf"), "-time", "yes",
+           "-remove_silence", "no", "-fsgusefiller", "no", "-beam", "1e-80", "-pbeam", "1e-80", "-wbeam", "1e-60",
+           "-logfn", os.devnull]
+    out = subprocess.run(cmd, capture_output=True, text=True).stdout
+    segments = []
+    for line in out.splitlines():
+        fields = line.split()
+        if len(fields) != 4 or fields[1][0].isalpha():
+            continue
+        word, start, end = fields[0], float(fields[1]), float(fields[2]) + 0.01
+        if word.startswith("ph_"):
+            name = phones[word[3:]]
+        elif word in ("<sil>", "sil", "<s>", "</s>") or word.startswith("["):
+            name = "sil"
+        else:
+            continue
+        segments.append((start, end, name))
+    return segments
+
+
+def write_lab(path, segments, duration):
+    merged = []
+    for start, end, name in segments:
+        if merged and merged[-1][2] == name and abs(merged[-1][1] - start) < 0.015:
+            merged[-1] = (merged[-1][0], end, name)
+        else:
+            merged.append((start, end, name))
+    with open(path, "w") as f:
+        last = 0.0
+        for start, end, name in merged:
+            if start > last + 0.015:
+                f.write(f"{last:.3f}\t{start:.3f}\tsil\n")
+            start = max(start, last)
+            end = min(end, duration)
+            if end > start:
+                f.write(f"{start:.3f}\t{end:.3f}\t{name}\n")
+                last = end
+        if duration > last + 0.015:
+            f.write(f"{last:.3f}\t{duration:.3f}\tsil\n")
+
+
+def convert(src, dst):
+    subprocess.run(["sox", "-q", str(src), "-r", "16000", "-c", "1", "-b", "16", str(dst)],
+                   check=True)
+    info = subprocess.run(["soxi", "-D", str(dst)], capture_output=True, text=True, check=True)
+    return float(info.stdout)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("root", type=Path)
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--subset", type=int, default=0, help="only the first N items per speaker")
+    ap.add_argument("--split", default="", help="only this split (train or dev)")
+    args = ap.parse_args()
+    speakers = load_speakers(HERE / "config/corpus/real-speakers.txt")
+    arpabet = load_map("arpabet")
+    phones = {p.lower(): arpabet[p.lower()] for p in ARPABET}
+    prons = None
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        (work / "ph.dict").write_text("".join(f"ph_{p.lower()} {p}\n" for p in ARPABET) +
+                                      "sil SIL\n")
+        for speaker, split, source in speakers:
+            if args.split and split != args.split:
+                continue
+            folder = args.out / split / speaker
+            folder.mkdir(parents=True, exist_ok=True)
+            made = skipped = 0
+            for name, audio, words, segments in items_of(args.root, source):
+                if args.subset and made >= args.subset:
+                    break
+                wav, lab = folder / f"{name}.wav", folder / f"{name}.lab"
+                if lab.exists() and wav.exists():
+                    made += 1
+                    continue
+                if words is not None:
+                    if prons is None:
+                        prons = load_dictionary()
+                    spelled = spelling(words, prons)
+                    if not spelled:
+                        skipped += 1
+                        continue
+                duration = convert(audio, wav)
+                if segments is None:
+                    segments = align(wav, spelled, work, phones)
+                    if not any(s[2] != "sil" for s in segments):
+                        wav.unlink()
+                        skipped += 1
+                        continue
+                write_lab(lab, segments, duration)
+                made += 1
+            log(f"{split}/{speaker}: {made} files ({skipped} skipped: words unknown or not aligned)")
+
+
+if __name__ == "__main__":
+    main()
