@@ -66,6 +66,7 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
     const std::map<std::string, float dsp::AlignerConfig::*> floats = {
         {"distanceWeight", &dsp::AlignerConfig::distanceWeight},
         {"speechInSilenceCost", &dsp::AlignerConfig::speechInSilenceCost},
+        {"consonantInSilenceCost", &dsp::AlignerConfig::consonantInSilenceCost},
         {"fillerCostPerFrame", &dsp::AlignerConfig::fillerCostPerFrame},
         {"silenceLoopCost", &dsp::AlignerConfig::silenceLoopCost},
         {"pauseCost", &dsp::AlignerConfig::pauseCost},
@@ -73,6 +74,7 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"beam", &dsp::AlignerConfig::beam}};
     const std::map<std::string, double dsp::AlignerConfig::*> doubles = {
         {"minVowelSeconds", &dsp::AlignerConfig::minVowelSeconds},
+        {"minPauseSeconds", &dsp::AlignerConfig::minPauseSeconds},
         {"minConsonantSeconds", &dsp::AlignerConfig::minConsonantSeconds},
         {"minFractionOfExpected", &dsp::AlignerConfig::minFractionOfExpected}};
     if (floats.count(name))

@@ -48,27 +48,37 @@ class GraphBuilder {
 
     // The pause and filler before word `gap` (after the last word when gap == words).
     void addGap(int gap) {
+        // Silence before and after the words is expected; between them it costs, and it lasts:
+        // a stop's closure at a word boundary is silent too, but short, and part of the stop.
+        const bool inner = gap > 0 && gap < graph_.words;
+        const int pauseFrames =
+            inner ? std::max(1, static_cast<int>(std::lround(config_.minPauseSeconds / hop_))) : 1;
         AlignmentNode pause{AlignmentNode::Kind::Pause};
         pause.phoneme = static_cast<int>(set_.silence());
         pause.word = gap;
-        pause.loopCost = config_.silenceLoopCost;
         AlignmentNode filler{AlignmentNode::Kind::Filler};
         filler.word = gap;
         filler.loopCost = 0;  // its cost is per frame, in the emission
-        const int p = add(pause), f = add(filler);
-        // The unit a gap ends is the word before it (or the start): both nodes join it.
+        const int first = add(pause);
+        int last = first;
+        for (int k = 1; k < pauseFrames; ++k) {
+            const int n = add(pause);
+            edge(last, n, 0);
+            last = n;
+        }
+        graph_.nodes[last].loopCost = config_.silenceLoopCost;
+        const int f = add(filler);
+        // The unit a gap ends is the word before it (or the start): both join it.
         const std::size_t unit = units_.size() - 1;
-        for (int node : {p, f}) {
-            // Silence before and after the words is expected; between them it costs.
-            const bool inner = gap > 0 && gap < graph_.words;
-            const float enter = node == p && inner ? config_.pauseCost : 0.0f;
+        for (int node : {first, f}) {
+            const float enter = node == first && inner ? config_.pauseCost : 0.0f;
             for (int from : units_[unit]) edge(from, node, enter);
             for (int s = 1; s <= kMaxSkippedInARow && s <= static_cast<int>(unit); ++s)
                 for (int from : units_[unit - s])  // the words between skipped
                     edge(from, node, enter + config_.skipWordCost * static_cast<float>(s));
         }
-        edge(p, f, 0);  // a pause, then something else; edges only go forward
-        units_.back().push_back(p);
+        edge(last, f, 0);  // a pause, then something else; edges only go forward
+        units_.back().push_back(last);
         units_.back().push_back(f);
     }
 

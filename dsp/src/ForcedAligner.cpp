@@ -85,7 +85,8 @@ void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool sil
             if (c == sil) {
                 cost = ex = 0;
             } else {
-                cost += config.speechInSilenceCost;
+                cost += (*set)[c].vowel ? config.speechInSilenceCost
+                                        : config.consonantInSilenceCost;
                 ex += kSilentExcessDb;
             }
         }

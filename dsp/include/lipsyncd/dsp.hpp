@@ -475,14 +475,20 @@ struct AlignerConfig {
     // Emission cost of a class in a frame: weight · (d² − d_min²), d the classifier's distance
     // (dB) to the class and d_min the frame's nearest; the nearest class costs nothing.
     float distanceWeight = 0.05f;
-    // Frames below the energy gate: cost of any class but silence.
+    // Frames below the energy gate: cost of a vowel, and of a consonant (a stop's closure and a
+    // weak fricative are quiet by nature).
     float speechInSilenceCost = 2.0f;
-    // Minimum durations: the segmenter's, and a fraction of the expected duration.
+    float consonantInSilenceCost = 0.3f;
+    // Minimum durations: the segmenter's, and a fraction of the expected duration. Tuned on the
+    // espeak-ng training corpus (bench/align_accuracy): fraction 0.3/0.4/0.5 gave boundary
+    // p95 48.5/48.5/46.5 ms; a minimum pause of 80 ms (not 1 frame) cut missed boundaries by a
+    // quarter (closures of stops at word boundaries had been taken for pauses).
     double minVowelSeconds = 0.03, minConsonantSeconds = 0.02;
-    double minFractionOfExpected = 0.4;
+    double minFractionOfExpected = 0.5;
     // A stretch no word explains (a cough, music, an added word): cost per frame.
     float fillerCostPerFrame = 1.5f;
     float pauseCost = 3.0f;         // entering an optional pause between words
+    double minPauseSeconds = 0.08;  // shortest pause between words
     float silenceLoopCost = 0.05f;  // per frame of it
     float skipWordCost = 40.0f;     // a word the speaker left out (at most two in a row)
     float beam = 60.0f;             // paths this much worse than the best are dropped
