@@ -40,10 +40,12 @@ std::string readTextFile(const std::string& file) {
 }
 
 void writeWords(std::ostream& out, const std::vector<dsp::AlignedWord>& words) {
-    out << "# start\tend\tword\tconfidence\tplaced\n" << std::fixed << std::setprecision(3);
+    out << "# start\tend\tword\tconfidence\tplaced\texcess_db\tduration_ratio\n"
+        << std::fixed << std::setprecision(3);
     for (const auto& w : words)
         out << w.start << '\t' << w.end << '\t' << w.text << '\t' << w.confidence << '\t'
-            << (w.placed ? "yes" : "no") << '\n';
+            << (w.placed ? "yes" : "no") << '\t' << w.excessDb << '\t' << w.durationRatio
+            << '\n';
 }
 
 void writeJson(std::ostream& out, const dsp::AlignFileResult& r) {

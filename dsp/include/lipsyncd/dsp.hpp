@@ -490,19 +490,21 @@ struct AlignerConfig {
     float pauseCost = 3.0f;         // entering an optional pause between words
     double minPauseSeconds = 0.08;  // shortest pause between words
     float silenceLoopCost = 0.05f;  // per frame of it
-    float skipWordCost = 40.0f;     // a word the speaker left out (at most two in a row)
+    float skipWordCost = 15.0f;     // a word the speaker left out (at most two in a row)
     float beam = 60.0f;             // paths this much worse than the best are dropped
     int maxActiveNodes = 4000;
     // Bounded memory: every commitSeconds, the path up to lookaheadSeconds ago is final.
     double commitSeconds = 10, lookaheadSeconds = 4;
     // Below this confidence a word counts as not placed (audio-only analysis covers it).
-    float minWordConfidence = 0.25f;
+    float minWordConfidence = 0.3f;
 };
 
 struct AlignedWord {
     std::string text;
     double start = 0, end = 0;  // where it was placed; both 0 when skipped
-    float confidence = 0;       // in [0, 1]
+    float confidence = 0;       // in [0, 1], from the two below
+    float excessDb = 0;         // mean distance of its frames above the nearest class's
+    float durationRatio = 0;    // its duration over the expected one
     bool placed = false;        // false: skipped, or confidence below the minimum
 };
 
