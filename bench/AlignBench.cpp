@@ -81,8 +81,7 @@ void WholeFile(benchmark::State& state) {
     const auto& m = material();
     const auto templates = dsp::TemplateSet::loadDefault();
     for (auto _ : state)
-        benchmark::DoNotOptimize(
-            dsp::alignFile(m.file, m.script, templates, PhonemeSet::common()));
+        benchmark::DoNotOptimize(dsp::alignFile(m.file, m.script, templates, PhonemeSet::common()));
     const double seconds = static_cast<double>(m.audio.size()) / m.rate;
     state.counters["x_realtime"] = benchmark::Counter(
         seconds * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);

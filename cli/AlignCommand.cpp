@@ -44,8 +44,7 @@ void writeWords(std::ostream& out, const std::vector<dsp::AlignedWord>& words) {
         << std::fixed << std::setprecision(3);
     for (const auto& w : words)
         out << w.start << '\t' << w.end << '\t' << w.text << '\t' << w.confidence << '\t'
-            << (w.placed ? "yes" : "no") << '\t' << w.excessDb << '\t' << w.durationRatio
-            << '\n';
+            << (w.placed ? "yes" : "no") << '\t' << w.excessDb << '\t' << w.durationRatio << '\n';
 }
 
 void writeJson(std::ostream& out, const dsp::AlignFileResult& r) {
@@ -125,10 +124,12 @@ void addAlignCommand(CLI::App& app) {
     o->runtime.addTo(*cmd, true);
     cmd->callback([o, schedule, text, file] {
         if (text->count() == 0 && file->count() == 0)
-            throw CLI::ValidationError("--text", "give the words: --text WORDS or --text-file FILE");
+            throw CLI::ValidationError("--text",
+                                       "give the words: --text WORDS or --text-file FILE");
         if (o->schedule.empty() && o->words.empty() && o->runtime.weights.empty())
-            throw CLI::ValidationError(schedule->get_name(),
-                                       "nothing to write: give --schedule, --words and/or --weights");
+            throw CLI::ValidationError(
+                schedule->get_name(),
+                "nothing to write: give --schedule, --words and/or --weights");
         runAlign(*o);
     });
 }

@@ -4,9 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
-#include <sstream>
-
 #include <lipsyncd/dsp.hpp>
+#include <sstream>
 
 namespace lipsyncd::dsp {
 

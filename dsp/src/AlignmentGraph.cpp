@@ -96,8 +96,8 @@ class GraphBuilder {
             const double classMin =
                 (set_[*idx].vowel ? config_.minVowelSeconds : config_.minConsonantSeconds) / hop_;
             const int chain = std::max(
-                1, static_cast<int>(std::lround(
-                       std::max(classMin, config_.minFractionOfExpected * expected))));
+                1, static_cast<int>(
+                       std::lround(std::max(classMin, config_.minFractionOfExpected * expected))));
             graph_.minimumFrames += chain;
             const double stay =
                 std::clamp(1.0 - 1.0 / std::max(1.0, expected - chain + 1), kMinStay, kMaxStay);
@@ -146,8 +146,8 @@ class GraphBuilder {
         for (int s = 0; s <= kMaxSkippedInARow && s < static_cast<int>(last) + 1; ++s)
             for (int node : units_[last - s])
                 if (graph_.nodes[node].kind != AlignmentNode::Kind::Start)
-                    graph_.endCost[node] =
-                        std::min(graph_.endCost[node], config_.skipWordCost * static_cast<float>(s));
+                    graph_.endCost[node] = std::min(graph_.endCost[node],
+                                                    config_.skipWordCost * static_cast<float>(s));
     }
 
     const PhonemeSet& set_;

@@ -16,8 +16,7 @@ constexpr double kLogDurationScale = 0.6;
 }  // namespace
 
 AlignmentPath::AlignmentPath(std::span<const ScriptWord> script, const AlignmentGraph& graph,
-                             const PhonemeSet& set, double hopSeconds,
-                             const AlignerConfig& config)
+                             const PhonemeSet& set, double hopSeconds, const AlignerConfig& config)
     : graph_(&graph), set_(&set), hop_(hopSeconds), config_(config), words_(script.size()) {
     for (const auto& w : script) texts_.push_back(w.text);
 }
@@ -71,8 +70,8 @@ Alignment AlignmentPath::finish(bool complete) {
             w.start = words_[i].start;
             w.end = words_[i].end;
             w.excessDb = static_cast<float>(words_[i].excessDb / words_[i].frames);
-            w.durationRatio = static_cast<float>(
-                (w.end - w.start) / std::max(hop_, graph_->wordExpectedSeconds[i]));
+            w.durationRatio = static_cast<float>((w.end - w.start) /
+                                                 std::max(hop_, graph_->wordExpectedSeconds[i]));
         }
         w.confidence = confidence(i);
         w.placed = words_[i].frames > 0 && w.confidence >= config_.minWordConfidence;

@@ -78,15 +78,14 @@ void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool sil
     for (std::size_t c = 0; c < classes; ++c) {
         const float d = c < distances.size() ? distances[c] : kNever;
         float ex = 0;
-        if (std::isfinite(nearest))
-            ex = std::isfinite(d) ? d - nearest : kMissingClassDb;
+        if (std::isfinite(nearest)) ex = std::isfinite(d) ? d - nearest : kMissingClassDb;
         float cost = config.distanceWeight * ex * (ex + 2 * (std::isfinite(nearest) ? nearest : 0));
         if (silent || !std::isfinite(nearest)) {  // below the gate, or no spectrum at all
             if (c == sil) {
                 cost = ex = 0;
             } else {
-                cost += (*set)[c].vowel ? config.speechInSilenceCost
-                                        : config.consonantInSilenceCost;
+                cost +=
+                    (*set)[c].vowel ? config.speechInSilenceCost : config.consonantInSilenceCost;
                 ex += kSilentExcessDb;
             }
         }
@@ -170,8 +169,7 @@ void ForcedAligner::State::emitPath(std::int64_t lastFrame, int node) {
     const std::size_t classes = set->size();
     for (std::size_t i = 0; i < nodes.size(); ++i) {
         const auto& row = rows[i];
-        path.add(row.time, nodes[i],
-                 std::span<const float>(excess).subspan(row.excess, classes));
+        path.add(row.time, nodes[i], std::span<const float>(excess).subspan(row.excess, classes));
     }
 }
 
@@ -254,6 +252,8 @@ double ForcedAligner::minimumSeconds() const {
     return state_->graph.minimumFrames * state_->hop;
 }
 
-std::size_t ForcedAligner::peakFramesHeld() const { return state_->peakRows; }
+std::size_t ForcedAligner::peakFramesHeld() const {
+    return state_->peakRows;
+}
 
 }  // namespace lipsyncd::dsp

@@ -72,8 +72,8 @@ TEST(AlignText, EspeakSpeechBoundariesMatchItsOwnTimings) {
     // The aligner's own boundaries (before words it is unsure of get audio-only analysis).
     const auto errors = boundaryErrors(r.alignment.schedule, s.labels);
     ASSERT_GT(errors.size(), 20u);
-    EXPECT_LE(errors[errors.size() / 2], 0.015);        // median
-    EXPECT_LE(errors[errors.size() * 9 / 10], 0.050);   // 90th percentile
+    EXPECT_LE(errors[errors.size() / 2], 0.015);       // median
+    EXPECT_LE(errors[errors.size() * 9 / 10], 0.050);  // 90th percentile
     // The schedule covers the file without gaps.
     EXPECT_DOUBLE_EQ(r.schedule.front().start, 0.0);
     for (std::size_t i = 1; i < r.schedule.size(); ++i)
@@ -126,8 +126,8 @@ TEST(AlignText, TheWrongTextIsFlaggedNotForced) {
 }
 
 TEST(AlignText, NumbersAreReadAsEspeakReadsThem) {
-    const auto script = scriptForText(synth(), "I have 3 puppets", "en-us",
-                                      espeakMapForVoice("en-us"), nullptr);
+    const auto script =
+        scriptForText(synth(), "I have 3 puppets", "en-us", espeakMapForVoice("en-us"), nullptr);
     ASSERT_EQ(script.size(), 4u);
     EXPECT_EQ(script[2].text, "3");
     std::string phonemes;

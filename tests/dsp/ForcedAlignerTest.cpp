@@ -67,8 +67,8 @@ std::vector<ScriptWord> mamaSeeWow() {
 void expectBoundariesAt(const PhonemeSchedule& s, const std::vector<double>& truth) {
     ASSERT_EQ(s.size(), truth.size() + 1);
     for (std::size_t i = 0; i < truth.size(); ++i)
-        EXPECT_NEAR(s[i + 1].start, truth[i], 1e-6) << "boundary " << i << " (" << s[i].phoneme
-                                                    << " | " << s[i + 1].phoneme << ")";
+        EXPECT_NEAR(s[i + 1].start, truth[i], 1e-6)
+            << "boundary " << i << " (" << s[i].phoneme << " | " << s[i + 1].phoneme << ")";
 }
 
 TEST(ForcedAligner, FindsKnownBoundariesExactly) {
@@ -144,9 +144,9 @@ TEST(ForcedAligner, LongInputIsAlignedInABoundedWindow) {
     ForcedAligner aligner(script, PhonemeSet::common(), kHop, 1.0, config);
     const auto a = f.align(script, &aligner);
     EXPECT_GT(f.distances.size(), 60000u);
-    EXPECT_LE(aligner.peakFramesHeld(),
-              static_cast<std::size_t>((config.commitSeconds + config.lookaheadSeconds) / kHop) +
-                  1);
+    EXPECT_LE(
+        aligner.peakFramesHeld(),
+        static_cast<std::size_t>((config.commitSeconds + config.lookaheadSeconds) / kHop) + 1);
     EXPECT_TRUE(a.complete);
     expectBoundariesAt(a.schedule, f.boundaries);
     for (const auto& w : a.words) ASSERT_TRUE(w.placed) << w.text;
@@ -176,9 +176,9 @@ TEST(ForcedAligner, TooFewFramesForTheWordsDoesNotCrash) {
 TEST(ForcedAligner, FramesWithoutSpectraAreSilence) {
     Frames f;
     f.add(kMama);
-    f.distances.insert(f.distances.begin(), 10,
-                       std::vector<float>(PhonemeSet::common().size(),
-                                          std::numeric_limits<float>::infinity()));
+    f.distances.insert(
+        f.distances.begin(), 10,
+        std::vector<float>(PhonemeSet::common().size(), std::numeric_limits<float>::infinity()));
     f.silent.insert(f.silent.begin(), 10, true);
     const std::vector<ScriptWord> script = {word("mama", kMama)};
     const auto a = f.align(script);

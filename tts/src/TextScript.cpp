@@ -80,8 +80,7 @@ bool hasSound(const dsp::ScriptWord& w) {
 std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::string& text,
                                            const std::string& voice, const PhonemeMap& map,
                                            std::vector<std::string>* warnings) {
-    if (std::all_of(text.begin(), text.end(),
-                    [](unsigned char c) { return std::isspace(c) != 0; }))
+    if (std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isspace(c) != 0; }))
         throw InputError("the text to align is empty");
     const auto speech = synth.synthesize({text, voice, 0, -1});
     const auto language = languageOf(voice);
