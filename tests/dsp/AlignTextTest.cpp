@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <lipsyncd/dsp.hpp>
 #include <lipsyncd/tts.hpp>
 
@@ -177,6 +178,39 @@ TEST(AlignText, AudioFarShorterThanTheWordsFallsBackWithAWarning) {
     for (const auto& w : r.warnings) said |= w.find("far shorter") != std::string::npos;
     EXPECT_TRUE(said);
     EXPECT_FALSE(r.schedule.empty());
+}
+
+// The service's path: a FILE.txt beside FILE.wav is used, and said so; without one, or with
+// words that cannot be used, the audio-only analysis.
+TEST(AlignText, WordsBesideAPlayedFileAreUsedAndLogged) {
+    const auto s = speak(kLine);
+    const auto file = wav("align_clip.wav", s.samples, s.rate);
+    auto words = file;
+    words.replace_extension(".txt");
+    std::filesystem::remove(words);
+    std::vector<std::string> log;
+    auto logger = [&](const std::string& line) { log.push_back(line); };
+    const auto templates = dsp::TemplateSet::loadDefault();
+    const auto audioOnly =
+        scheduleForClip(synth(), file, std::nullopt, "en-us", templates, {}, logger);
+    EXPECT_TRUE(log.empty());
+    EXPECT_EQ(audioOnly, dsp::analyzeFile(file, templates, PhonemeSet::common()).schedule);
+
+    std::ofstream(words) << kLine << '\n';
+    const auto aligned =
+        scheduleForClip(synth(), file, std::nullopt, "en-us", templates, {}, logger);
+    ASSERT_FALSE(log.empty());
+    EXPECT_NE(log.front().find(words.string()), std::string::npos) << log.front();
+    const auto errors = boundaryErrors(aligned, s.labels);
+    EXPECT_LE(errors[errors.size() / 2], 0.015);
+
+    log.clear();
+    std::ofstream(words) << "  \n";  // empty words: said, and audio-only analysis
+    EXPECT_EQ(scheduleForClip(synth(), file, std::nullopt, "en-us", templates, {}, logger),
+              audioOnly);
+    ASSERT_FALSE(log.empty());
+    EXPECT_NE(log.front().find("not used"), std::string::npos) << log.front();
+    std::filesystem::remove(words);
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <lipsyncd/dsp.hpp>
 
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -84,5 +86,19 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
                                const dsp::AlignerConfig& aligner = {},
                                const dsp::DecodeOptions& decode = {},
                                const std::optional<dsp::RawFormat>& raw = std::nullopt);
+
+// The schedule of an audio file about to be played: aligned on `text` when given, else on the
+// words of a `FILE.txt` beside `FILE.wav` when there is one, else the audio-only analysis. Text
+// that cannot be aligned (empty, unreadable) falls back to the audio-only analysis. `log` gets
+// one line saying which was used, and the alignment's warnings. For the service's clip
+// preparation.
+PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
+                                const std::optional<std::string>& text, const std::string& voice,
+                                const dsp::TemplateSet& templates,
+                                const dsp::DecodeOptions& decode,
+                                const std::function<void(const std::string&)>& log);
+
+// The words file beside an audio file (FILE.wav → FILE.txt), if there is one.
+std::optional<std::filesystem::path> wordsBeside(const std::filesystem::path& audio);
 
 }  // namespace lipsyncd
