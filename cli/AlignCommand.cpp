@@ -59,8 +59,8 @@ void writeJson(std::ostream& out, const dsp::AlignFileResult& r) {
                                 {"end", w.end},
                                 {"confidence", w.confidence},
                                 {"placed", w.placed}});
-    doc["audio_only"] = nlohmann::json::array();  // stretches taken from audio-only analysis
-    for (const auto& [a, b] : r.alignment.unexplained) doc["audio_only"].push_back({a, b});
+    doc["unexplained"] = nlohmann::json::array();  // stretches no word explains (audio-only)
+    for (const auto& [a, b] : r.alignment.unexplained) doc["unexplained"].push_back({a, b});
     doc["fell_back"] = r.fellBack;
     doc["warnings"] = r.warnings;
     out << doc.dump(1) << '\n';
