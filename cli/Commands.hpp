@@ -8,6 +8,7 @@ namespace lipsyncd::cli {
 
 void addSayCommand(CLI::App& app);
 void addAnalyzeCommand(CLI::App& app);
+void addAlignCommand(CLI::App& app);
 void addEvalCommand(CLI::App& app);
 void addTrainCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);

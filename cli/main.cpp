@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
 
     using namespace lipsyncd::cli;
     addAnalyzeCommand(app);
+    addAlignCommand(app);
     addEvalCommand(app);
     addTrainCommand(app);
     addCalibrateCommand(app);

@@ -14,6 +14,13 @@ std::atomic<bool> gInstanceAlive{false};
 struct Collector {
     std::vector<std::int16_t>* samples;
     std::vector<std::pair<double, std::string>> events;  // (time s, mnemonic)
+    // Word starts: (character position in the text, 1-based; length in characters; the index
+    // of the first phoneme event after it).
+    struct Word {
+        int position, length;
+        std::size_t firstEvent;
+    };
+    std::vector<Word> words;
 };
 
 // espeak-ng hands over audio in chunks, each with the events inside it. A chunk may carry no
@@ -29,6 +36,8 @@ int onSynth(short* wav, int count, espeak_EVENT* events) {
             std::memcpy(name, e->id.string, 8);
             collector->events.emplace_back(e->audio_position / 1000.0, name);
         }
+        if (collector && e->type == espeakEVENT_WORD)
+            collector->words.push_back({e->text_position, e->length, collector->events.size()});
         if (e->type == espeakEVENT_LIST_TERMINATED) break;
     }
     if (collector && wav && count > 0 && collector->samples)
@@ -66,6 +75,37 @@ bool selectVoice(const std::string& voice) {
     return espeak_SetVoiceByName(withVariant.c_str()) == EE_OK;
 }
 
+// Characters (espeak-ng counts code points from 1) to byte offsets in UTF-8 text.
+std::size_t byteOffset(const std::string& text, int characters) {
+    std::size_t i = 0;
+    for (int c = 0; c < characters && i < text.size(); ++c) {
+        ++i;
+        while (i < text.size() && (static_cast<unsigned char>(text[i]) & 0xC0) == 0x80) ++i;
+    }
+    return i;
+}
+
+// Each word event owns the phoneme events from it to the next word event; pauses before the
+// first word belong to none.
+std::vector<SpokenWord> spokenWords(const std::string& text, const Collector& c, double total) {
+    std::vector<SpokenWord> words;
+    for (std::size_t w = 0; w < c.words.size(); ++w) {
+        const auto& mark = c.words[w];
+        const auto from = byteOffset(text, mark.position - 1);
+        const auto to = byteOffset(text, mark.position - 1 + mark.length);
+        SpokenWord word{text.substr(from, to - from), {}};
+        const auto last = w + 1 < c.words.size() ? c.words[w + 1].firstEvent : c.events.size();
+        for (std::size_t i = mark.firstEvent; i < last; ++i) {
+            const double start = std::min(c.events[i].first, total);
+            const double end = i + 1 < c.events.size() ? std::min(c.events[i + 1].first, total)
+                                                       : total;
+            if (end > start) word.phonemes.push_back({start, end, c.events[i].second, 1.0f});
+        }
+        words.push_back(std::move(word));
+    }
+    return words;
+}
+
 }  // namespace
 
 EspeakSynthesizer::EspeakSynthesizer(const std::string& dataPath) {
@@ -95,7 +135,7 @@ SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request)
 
     SynthesizedSpeech out;
     out.sampleRate = sampleRate_;
-    Collector collector{&out.samples, {}};
+    Collector collector{&out.samples, {}, {}};
     const auto rc = espeak_Synth(request.text.c_str(), request.text.size() + 1, 0, POS_CHARACTER, 0,
                                  espeakCHARS_UTF8, nullptr, &collector);
     if (rc != EE_OK) throw std::runtime_error("espeak-ng: synthesis failed");
@@ -108,6 +148,7 @@ SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request)
         const double end = i + 1 < ev.size() ? std::min(ev[i + 1].first, total) : total;
         if (end > start) out.phonemes.push_back({start, end, ev[i].second, 1.0f});
     }
+    out.words = spokenWords(request.text, collector, total);
     return out;
 }
 

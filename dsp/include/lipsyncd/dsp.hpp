@@ -11,6 +11,8 @@
 //   StreamingAnalyzer   all of the above over a stream of samples at any rate, emitting
 //                       frames and closed segments as they happen.
 //   analyzeFile()       the whole chain over a file, for the command line and tests.
+//   ForcedAligner       known words: Viterbi alignment of their phonemes on the classifier's
+//                       per-frame distances, in bounded memory (alignFile() over a file).
 //
 // Real-time paths (StreamingAnalyzer::push and everything under it) do not allocate once
 // constructed, except for the segments handed out.
@@ -448,6 +450,9 @@ class StreamingAnalyzer {
     // window, the decoder's lag and the segmenter's hold.
     double latencySeconds() const;
     double resamplerDelaySeconds() const { return frames_.resamplerDelaySeconds(); }
+    // The classifier's distance to each class for the frame being handed to the frame sink
+    // (FrameClassifier::distances()); valid only inside the sink.
+    std::span<const float> distances() const { return classifier_.distances(); }
 
   private:
     void onFeatures(const FrameFeatures& features);
@@ -556,5 +561,112 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
                            const DecodeOptions& decode = {},
                            const std::optional<RawFormat>& raw = std::nullopt,
                            bool keepFrames = false);
+
+// ---------------------------------------------------------------------------------------------
+// Forced alignment: the words are known, only their timing comes from the audio.
+
+// One written word and the phonemes it is spoken with (set names), each with the duration the
+// synthesiser gives it at its own rate (only the durations are used, not the times).
+struct ScriptWord {
+    std::string text;
+    PhonemeSchedule phonemes;
+};
+
+struct AlignerConfig {
+    // Emission cost of a class in a frame: weight · (d² − d_min²), d the classifier's distance
+    // (dB) to the class and d_min the frame's nearest; the nearest class costs nothing.
+    float distanceWeight = 0.05f;
+    // Frames below the energy gate: cost of a vowel, and of a consonant (a stop's closure and a
+    // weak fricative are quiet by nature).
+    float speechInSilenceCost = 2.0f;
+    float consonantInSilenceCost = 0.3f;
+    // Minimum durations: the segmenter's, and a fraction of the expected duration. Tuned on the
+    // espeak-ng training corpus (bench/align_accuracy): fraction 0.3/0.4/0.5 gave boundary
+    // p95 48.5/48.5/46.5 ms; a minimum pause of 80 ms (not 1 frame) cut missed boundaries by a
+    // quarter (closures of stops at word boundaries had been taken for pauses).
+    double minVowelSeconds = 0.03, minConsonantSeconds = 0.02;
+    double minFractionOfExpected = 0.5;
+    // A stretch no word explains (a cough, music, an added word): cost per frame.
+    float fillerCostPerFrame = 1.5f;
+    float pauseCost = 3.0f;         // entering an optional pause between words
+    double minPauseSeconds = 0.08;  // shortest pause between words
+    float silenceLoopCost = 0.05f;  // per frame of it
+    float skipWordCost = 15.0f;     // a word the speaker left out (at most two in a row)
+    float beam = 60.0f;             // paths this much worse than the best are dropped
+    int maxActiveNodes = 4000;
+    // Bounded memory: every commitSeconds, the path up to lookaheadSeconds ago is final.
+    double commitSeconds = 10, lookaheadSeconds = 4;
+    // Below this confidence a word counts as not placed (audio-only analysis covers it).
+    float minWordConfidence = 0.3f;
+};
+
+struct AlignedWord {
+    std::string text;
+    double start = 0, end = 0;  // where it was placed; both 0 when skipped
+    float confidence = 0;       // in [0, 1], from the two below
+    float excessDb = 0;         // mean distance of its frames above the nearest class's
+    float durationRatio = 0;    // its duration over the expected one
+    bool placed = false;        // false: skipped, or confidence below the minimum
+};
+
+struct Alignment {
+    PhonemeSchedule schedule;  // the aligned phonemes (pauses and unexplained stretches: sil)
+    std::vector<AlignedWord> words;
+    // Stretches no script word explains (filler: a cough, music, added words).
+    std::vector<std::pair<double, double>> unexplained;
+    bool complete = false;  // false: no path through the words; the caller must fall back
+};
+
+// Frame-synchronous Viterbi over the script's phonemes (a chain of minimum-duration states and
+// a geometric tail per phoneme: Rabiner 1989, section IV.D), with an optional pause and an
+// optional filler between words and word skips, beam-pruned; the path is committed in windows
+// (partial traceback) so memory is bounded by the window and the script, not the audio.
+class ForcedAligner {
+  public:
+    // timeScale: audio durations / synthesiser durations (speech rate), e.g. from
+    // estimateTimeScale(); hopSeconds: the frame hop.
+    ForcedAligner(std::span<const ScriptWord> script, const PhonemeSet& set, double hopSeconds,
+                  double timeScale = 1.0, const AlignerConfig& config = {});
+    ForcedAligner(ForcedAligner&&) noexcept;
+    ForcedAligner& operator=(ForcedAligner&&) noexcept;
+    ~ForcedAligner();
+
+    // One frame: its centre time, the classifier's distance to each class (+inf: no template
+    // or no spectrum) and whether it is below the energy gate.
+    void push(double time, std::span<const float> distances, bool silent);
+    Alignment finish();
+    // The shortest audio the script fits in (minimum durations), seconds.
+    double minimumSeconds() const;
+    // Largest number of frames of back-pointers held at once (the memory bound, for tests).
+    std::size_t peakFramesHeld() const;
+
+  private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
+struct AlignFileResult {
+    PhonemeSchedule schedule;  // aligned where words were placed, audio-only elsewhere
+    PhonemeSchedule audioOnly;  // the front end's own schedule (analyzeFile)
+    Alignment alignment;
+    double durationSeconds = 0, timeScale = 1;
+    std::vector<std::string> warnings;  // unplaced words, fallbacks: for the user
+    bool fellBack = false;              // the whole file is audio-only analysis
+};
+
+// The synthesiser's durations of the script against the speech found in the file: how much
+// slower (> 1) the speaker is. 1 when the file has no speech.
+double estimateTimeScale(std::span<const ScriptWord> script, const std::filesystem::path& file,
+                         const DecodeOptions& decode = {},
+                         const std::optional<RawFormat>& raw = std::nullopt);
+
+// Aligns the script on a file, with the audio-only schedule in the stretches the script does
+// not explain and for words not placed. Bad audio (no speech, far too short for the words)
+// gives a flagged audio-only result, not an error. `raw` input is read once (no time scale).
+AlignFileResult alignFile(const std::filesystem::path& file, std::span<const ScriptWord> script,
+                          const TemplateSet& templates, const PhonemeSet& set,
+                          const FrontEndConfig& config = {}, const AlignerConfig& aligner = {},
+                          const DecodeOptions& decode = {},
+                          const std::optional<RawFormat>& raw = std::nullopt);
 
 }  // namespace lipsyncd::dsp

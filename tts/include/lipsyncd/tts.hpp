@@ -4,8 +4,11 @@
 #pragma once
 
 #include <lipsyncd/core.hpp>
+#include <lipsyncd/dsp.hpp>
 
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,12 +21,21 @@ struct SynthesisRequest {
     int pitch = -1;               // 0..100, -1: default
 };
 
+// One word of the text as espeak-ng read it: a number may become several spoken words, all
+// under the one written word.
+struct SpokenWord {
+    std::string text;           // as written in the request
+    PhonemeSchedule phonemes;   // its phonemes in espeak-ng's mnemonics, with its timings
+};
+
 struct SynthesizedSpeech {
     std::vector<std::int16_t> samples;  // mono
     int sampleRate = 0;                 // espeak-ng's own rate (22050 Hz)
     // Phonemes in the synthesiser's own mnemonics (e.g. espeak-ng's "aI", "tS", "_:"); stress
     // and punctuation marks are kept so the caller's map can decide what to ignore.
     PhonemeSchedule phonemes;
+    // The same phonemes by written word (espeak-ng's word events).
+    std::vector<SpokenWord> words;
 };
 
 // espeak-ng holds global state, so one synthesiser exists at a time (a second throws).
@@ -52,5 +64,41 @@ PhonemeSchedule mapSchedule(const PhonemeSchedule& raw, const PhonemeMap& map,
 // The map for a voice: config/phonemes/espeak-<language>.toml, e.g. "en-us+f2" -> espeak-en.
 // Throws InputError naming the voice when no map covers its language.
 PhonemeMap espeakMapForVoice(const std::string& voice);
+
+// ---------------------------------------------------------------------------------------------
+// Known words: the script a forced alignment follows (dsp::ForcedAligner).
+
+// The words of `text` with their phonemes in `map`'s set and espeak-ng's durations, read by
+// espeak-ng itself (numbers, abbreviations and punctuation as it reads them). Words in a script
+// the voice cannot read (it would spell them letter by letter) are left out with a warning, so
+// the aligner treats them as unexplained speech. Throws InputError for empty text and for text
+// with no word left.
+std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::string& text,
+                                           const std::string& voice, const PhonemeMap& map,
+                                           std::vector<std::string>* warnings);
+
+// Aligns `text` on the speech in `audio` with the voice's phoneme map and the given front end;
+// the result says which words were placed and where the audio-only analysis stands in.
+dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::path& audio,
+                               const std::string& text, const std::string& voice,
+                               const dsp::TemplateSet& templates,
+                               const dsp::FrontEndConfig& frontEnd = {},
+                               const dsp::AlignerConfig& aligner = {},
+                               const dsp::DecodeOptions& decode = {},
+                               const std::optional<dsp::RawFormat>& raw = std::nullopt);
+
+// The schedule of an audio file about to be played: aligned on `text` when given, else on the
+// words of a `FILE.txt` beside `FILE.wav` when there is one, else the audio-only analysis. Text
+// that cannot be aligned (empty, unreadable) falls back to the audio-only analysis. `log` gets
+// one line saying which was used, and the alignment's warnings. For the service's clip
+// preparation.
+PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
+                                const std::optional<std::string>& text, const std::string& voice,
+                                const dsp::TemplateSet& templates,
+                                const dsp::DecodeOptions& decode,
+                                const std::function<void(const std::string&)>& log);
+
+// The words file beside an audio file (FILE.wav → FILE.txt), if there is one.
+std::optional<std::filesystem::path> wordsBeside(const std::filesystem::path& audio);
 
 }  // namespace lipsyncd

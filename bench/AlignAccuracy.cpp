@@ -1,0 +1,145 @@
+// Forced-alignment accuracy on an espeak-ng corpus (scripts/make-corpus.sh): every NAME.wav is
+// aligned with its sentence and its phoneme boundaries compared with NAME.lab (espeak-ng's own
+// timings). The voice's language (not its variant, rate or pitch) is what the aligner is told.
+//
+//   build/bench/align_accuracy CORPUS_DIR SENTENCES_FILE [name=value ...]
+//   build/bench/align_accuracy build/corpus/dev config/corpus/dev-sentences.txt
+//
+// name=value sets an AlignerConfig field (see kFields) for tuning, which is done on the
+// training corpus, never on dev. A reference boundary is matched with the nearest aligned
+// boundary between the same two classes; one with no such partner within 100 ms is "missed"
+// and counted at 100 ms in the percentiles.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <lipsyncd/dsp.hpp>
+#include <lipsyncd/tts.hpp>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace lipsyncd;
+namespace fs = std::filesystem;
+
+constexpr double kMissedSeconds = 0.1;
+
+struct Boundary {
+    double time;
+    std::string left, right;
+};
+
+std::vector<Boundary> boundaries(const PhonemeSchedule& s) {
+    std::vector<Boundary> out;
+    for (std::size_t i = 1; i < s.size(); ++i)
+        if (s[i].phoneme != s[i - 1].phoneme)
+            out.push_back({s[i].start, s[i - 1].phoneme, s[i].phoneme});
+    return out;
+}
+
+std::vector<double> boundaryErrors(const PhonemeSchedule& hyp, const PhonemeSchedule& ref) {
+    const auto h = boundaries(hyp);
+    std::vector<double> errors;
+    for (const auto& r : boundaries(ref)) {
+        double best = kMissedSeconds;
+        for (const auto& b : h)
+            if (b.left == r.left && b.right == r.right)
+                best = std::min(best, std::abs(b.time - r.time));
+        errors.push_back(best);
+    }
+    return errors;
+}
+
+double percentile(std::vector<double> v, double p) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    return v[static_cast<std::size_t>(std::min<double>(v.size() - 1, p * (v.size() - 1) + 0.5))];
+}
+
+void set(dsp::AlignerConfig& c, const std::string& assignment) {
+    const auto eq = assignment.find('=');
+    const std::string name = assignment.substr(0, eq);
+    const double v = std::stod(assignment.substr(eq + 1));
+    const std::map<std::string, float dsp::AlignerConfig::*> floats = {
+        {"distanceWeight", &dsp::AlignerConfig::distanceWeight},
+        {"speechInSilenceCost", &dsp::AlignerConfig::speechInSilenceCost},
+        {"consonantInSilenceCost", &dsp::AlignerConfig::consonantInSilenceCost},
+        {"fillerCostPerFrame", &dsp::AlignerConfig::fillerCostPerFrame},
+        {"silenceLoopCost", &dsp::AlignerConfig::silenceLoopCost},
+        {"pauseCost", &dsp::AlignerConfig::pauseCost},
+        {"skipWordCost", &dsp::AlignerConfig::skipWordCost},
+        {"beam", &dsp::AlignerConfig::beam}};
+    const std::map<std::string, double dsp::AlignerConfig::*> doubles = {
+        {"minVowelSeconds", &dsp::AlignerConfig::minVowelSeconds},
+        {"minPauseSeconds", &dsp::AlignerConfig::minPauseSeconds},
+        {"minConsonantSeconds", &dsp::AlignerConfig::minConsonantSeconds},
+        {"minFractionOfExpected", &dsp::AlignerConfig::minFractionOfExpected}};
+    if (floats.count(name))
+        c.*floats.at(name) = static_cast<float>(v);
+    else if (doubles.count(name))
+        c.*doubles.at(name) = v;
+    else
+        throw std::runtime_error("unknown field " + name);
+}
+
+// "s03_en-gb-x-rp_m7" → "en-gb-x-rp"
+// The corpus keeps each voice in its own folder, VOICE/sNN.wav (en-us_f5: language en-us).
+std::string languageOf(const fs::path& wav) {
+    const auto voice = wav.parent_path().filename().string();
+    return voice.substr(0, voice.find('_'));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 3) {
+        std::cerr << "usage: align_accuracy CORPUS_DIR SENTENCES_FILE [name=value ...]\n";
+        return 2;
+    }
+    dsp::AlignerConfig config;
+    for (int i = 3; i < argc; ++i) set(config, argv[i]);
+    std::vector<std::string> sentences;
+    std::ifstream in(argv[2]);
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty() && line[0] != '#') sentences.push_back(line);
+
+    std::vector<fs::path> files;
+    for (const auto& e : fs::recursive_directory_iterator(argv[1]))
+        if (e.path().extension() == ".wav") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+
+    EspeakSynthesizer synth;
+    const auto templates = dsp::TemplateSet::loadDefault();
+    std::vector<double> errors;
+    std::size_t words = 0, placed = 0;
+    double audioSeconds = 0, cpuSeconds = 0;
+    for (const auto& wav : files) {
+        const auto name = wav.stem().string();
+        const auto index = static_cast<std::size_t>(std::stoi(name.substr(1, 2))) - 1;
+        const auto ref = readScheduleFile(fs::path(wav).replace_extension(".lab"));
+        const auto t0 = std::chrono::steady_clock::now();
+        const auto r =
+            alignText(synth, wav, sentences.at(index), languageOf(wav), templates, {}, config);
+        cpuSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        audioSeconds += r.durationSeconds;
+        const auto e = boundaryErrors(r.schedule, ref);
+        errors.insert(errors.end(), e.begin(), e.end());
+        for (const auto& w : r.alignment.words) {
+            ++words;
+            placed += w.placed;
+        }
+    }
+    const auto missed = std::count(errors.begin(), errors.end(), kMissedSeconds);
+    std::cout << files.size() << " files, " << errors.size() << " boundaries, " << missed
+              << " missed; words placed " << placed << "/" << words << "\n"
+              << "median " << percentile(errors, 0.5) * 1000 << " ms, p90 "
+              << percentile(errors, 0.9) * 1000 << " ms, p95 " << percentile(errors, 0.95) * 1000
+              << " ms; within 20 ms "
+              << std::count_if(errors.begin(), errors.end(), [](double e) { return e <= 0.02; }) *
+                     100.0 / std::max<std::size_t>(1, errors.size())
+              << " %\nspeed (whole pipeline incl. espeak-ng and decoding) "
+              << audioSeconds / cpuSeconds << "x real time\n";
+}

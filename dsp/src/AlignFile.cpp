@@ -1,0 +1,203 @@
+// Forced alignment over a file: a quick level pass for the speaking rate, then the front end
+// feeding the aligner frame by frame, and the audio-only schedule wherever the words could not
+// be placed (the front end's own recognition, as `lipsync analyze` gives it).
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <lipsyncd/dsp.hpp>
+#include <sstream>
+
+namespace lipsyncd::dsp {
+
+namespace {
+constexpr std::size_t kReadBlock = 4096;
+// Speech is what lies within this many dB of the loudest 10 ms block, and above the floor.
+constexpr double kSpeechBelowPeakDb = 35, kSpeechFloorDbfs = -55;
+// The speaking rate is believed within these bounds (espeak-ng's 80..450 words per minute
+// against its default 175 spans about 0.4..2.2).
+constexpr double kMinTimeScale = 0.5, kMaxTimeScale = 2.0;
+// Audio shorter than this fraction of the script's minimum cannot hold the words.
+constexpr double kTooShortFraction = 0.8;
+
+double scriptSeconds(std::span<const ScriptWord> script) {
+    double total = 0;
+    for (const auto& w : script)
+        for (const auto& p : w.phonemes)
+            if (p.phoneme != "sil") total += p.duration();
+    return total;
+}
+
+std::string seconds(double s) {
+    std::ostringstream out;
+    out << std::fixed << std::setprecision(2) << s << " s";
+    return out.str();
+}
+
+// Cuts [from, to) out of `base` and puts `fill`'s segments (clipped) there; both cover the
+// whole file without gaps.
+PhonemeSchedule splice(const PhonemeSchedule& base, const PhonemeSchedule& fill, double from,
+                       double to) {
+    PhonemeSchedule out;
+    auto put = [&](PhonemeSegment s, double a, double b) {
+        s.start = std::max(s.start, a);
+        s.end = std::min(s.end, b);
+        if (s.end - s.start < 1e-9) return;
+        if (!out.empty() && out.back().phoneme == s.phoneme && out.back().end >= s.start - 1e-9)
+            out.back().end = s.end;
+        else
+            out.push_back(s);
+    };
+    for (const auto& s : base) put(s, 0, from);
+    for (const auto& s : fill) put(s, from, to);
+    for (const auto& s : base) put(s, to, base.back().end);
+    return out;
+}
+
+// The stretches to take from the audio-only schedule: what no word explains, and words not
+// placed (from the end of the placed word before to the start of the placed word after).
+std::vector<std::pair<double, double>> fallbackStretches(const Alignment& a, double duration) {
+    auto stretches = a.unexplained;
+    for (std::size_t i = 0; i < a.words.size(); ++i) {
+        if (a.words[i].placed) continue;
+        double from = 0, to = duration;
+        for (std::size_t j = i; j-- > 0;)
+            if (a.words[j].placed) {
+                from = a.words[j].end;
+                break;
+            }
+        for (std::size_t j = i + 1; j < a.words.size(); ++j)
+            if (a.words[j].placed) {
+                to = a.words[j].start;
+                break;
+            }
+        if (to > from) stretches.emplace_back(from, to);
+    }
+    std::sort(stretches.begin(), stretches.end());
+    std::vector<std::pair<double, double>> merged;
+    for (const auto& s : stretches)
+        if (!merged.empty() && s.first <= merged.back().second)
+            merged.back().second = std::max(merged.back().second, s.second);
+        else
+            merged.push_back(s);
+    return merged;
+}
+
+void warnAboutWords(AlignFileResult& r) {
+    for (const auto& w : r.alignment.words)
+        if (!w.placed) {
+            std::ostringstream msg;
+            msg << "word '" << w.text << "' ";
+            if (w.end > w.start)
+                msg << "placed only with confidence " << std::setprecision(2) << w.confidence
+                    << " at " << seconds(w.start) << ": audio-only analysis used there";
+            else
+                msg << "not found in the audio (skipped by the speaker?)";
+            r.warnings.push_back(msg.str());
+        }
+    for (const auto& [a, b] : r.alignment.unexplained)
+        if (b - a >= 0.1)
+            r.warnings.push_back("no word explains " + seconds(a) + " to " + seconds(b) +
+                                 ": audio-only analysis used there");
+}
+}  // namespace
+
+double estimateTimeScale(std::span<const ScriptWord> script, const std::filesystem::path& file,
+                         const DecodeOptions& decode, const std::optional<RawFormat>& raw) {
+    auto decoder = AudioDecoder::open(file, decode, raw);
+    const auto blockSize = std::max<std::size_t>(1, decoder.sampleRate() / 100);
+    std::vector<float> block(blockSize);
+    std::vector<float> levels;  // dBFS per 10 ms: 400 bytes a second of audio
+    for (;;) {
+        std::size_t got = 0;
+        while (got < blockSize) {
+            const auto n = decoder.read(std::span<float>(block).subspan(got));
+            if (n == 0) break;
+            got += n;
+        }
+        if (got == 0) break;
+        double sum = 0;
+        for (std::size_t i = 0; i < got; ++i) sum += double(block[i]) * block[i];
+        levels.push_back(static_cast<float>(10 * std::log10(sum / got + 1e-20)));
+        if (got < blockSize) break;
+    }
+    if (levels.empty()) return 1.0;
+    const double peak = *std::max_element(levels.begin(), levels.end());
+    const double gate = std::max(peak - kSpeechBelowPeakDb, kSpeechFloorDbfs);
+    std::size_t first = levels.size(), last = 0;
+    for (std::size_t i = 0; i < levels.size(); ++i)
+        if (levels[i] >= gate) {
+            first = std::min(first, i);
+            last = i;
+        }
+    const double expected = scriptSeconds(script);
+    if (first > last || expected <= 0) return 1.0;
+    const double speech = static_cast<double>(last - first + 1) * 0.01;
+    return std::clamp(speech / expected, kMinTimeScale, kMaxTimeScale);
+}
+
+AlignFileResult alignFile(const std::filesystem::path& file, std::span<const ScriptWord> script,
+                          const TemplateSet& templates, const PhonemeSet& set,
+                          const FrontEndConfig& config, const AlignerConfig& alignerConfig,
+                          const DecodeOptions& decode, const std::optional<RawFormat>& raw) {
+    AlignFileResult r;
+    if (file != "-") r.timeScale = estimateTimeScale(script, file, decode, raw);
+    auto decoder = AudioDecoder::open(file, decode, raw);
+    StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
+    ForcedAligner aligner(script, set, templates.analysis.hopSeconds, r.timeScale, alignerConfig);
+    std::size_t speechFrames = 0;
+    analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
+        aligner.push(f.label.time, analyzer.distances(), f.label.silent);
+        speechFrames += !f.label.silent;
+    });
+    analyzer.onSegment([&](const PhonemeSegment& s) { r.audioOnly.push_back(s); });
+    std::vector<float> block(kReadBlock);
+    std::int64_t total = 0;
+    while (const auto n = decoder.read(block)) {
+        analyzer.push(std::span<const float>(block.data(), n));
+        total += static_cast<std::int64_t>(n);
+    }
+    analyzer.finish();
+    r.durationSeconds = static_cast<double>(total) / decoder.sampleRate();
+    if (!r.audioOnly.empty()) r.audioOnly.back().end = r.durationSeconds;
+    r.alignment = aligner.finish();
+
+    const std::string name = decoder.name();
+    if (speechFrames == 0) {
+        r.fellBack = true;
+        r.warnings.push_back(name + ": no speech found (silence only): nothing to align");
+    } else if (r.durationSeconds < kTooShortFraction * aligner.minimumSeconds()) {
+        r.fellBack = true;
+        r.warnings.push_back(name + ": audio (" + seconds(r.durationSeconds) +
+                             ") far shorter than the words need (at least " +
+                             seconds(aligner.minimumSeconds()) + "): not aligned");
+    } else if (!r.alignment.complete) {
+        r.fellBack = true;
+        r.warnings.push_back(name + ": no alignment through the words was found");
+    }
+    if (r.fellBack) {
+        for (auto& w : r.alignment.words) w.placed = false;
+        r.warnings.push_back(name + ": audio-only analysis used for the whole file");
+        r.schedule = r.audioOnly;
+        return r;
+    }
+    warnAboutWords(r);
+    r.schedule = r.alignment.schedule;
+    // Before the first frame and after the last, nothing was heard: silence, not a phoneme.
+    if (!r.schedule.empty()) {
+        auto& first = r.schedule.front();
+        if (first.phoneme == "sil")
+            first.start = 0;
+        else if (first.start > 0)
+            r.schedule.insert(r.schedule.begin(), {0.0, first.start, "sil", 1.0f});
+        auto& last = r.schedule.back();
+        if (last.phoneme == "sil")
+            last.end = std::max(last.end, r.durationSeconds);
+        else if (last.end < r.durationSeconds)
+            r.schedule.push_back({last.end, r.durationSeconds, "sil", 1.0f});
+    }
+    for (const auto& [from, to] : fallbackStretches(r.alignment, r.durationSeconds))
+        r.schedule = splice(r.schedule, r.audioOnly, from, to);
+    return r;
+}
+
+}  // namespace lipsyncd::dsp

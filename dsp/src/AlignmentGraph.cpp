@@ -1,0 +1,174 @@
+#include "AlignmentGraph.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lipsyncd::dsp {
+
+namespace {
+
+// At most this many words in a row may be skipped (each at skipWordCost).
+constexpr int kMaxSkippedInARow = 2;
+// The tail's stay probability is kept in this range: a phoneme may always end, and always stay.
+constexpr double kMinStay = 0.05, kMaxStay = 0.97;
+
+class GraphBuilder {
+  public:
+    GraphBuilder(const PhonemeSet& set, double hop, double scale, const AlignerConfig& c)
+        : set_(set), hop_(hop), scale_(scale), config_(c) {}
+
+    AlignmentGraph build(std::span<const ScriptWord> script) {
+        graph_.words = static_cast<int>(script.size());
+        add({AlignmentNode::Kind::Start});
+        units_.push_back({0});
+        addGap(0);
+        for (std::size_t w = 0; w < script.size(); ++w) {
+            addWord(script[w], static_cast<int>(w));
+            addGap(static_cast<int>(w) + 1);
+        }
+        flatten();
+        return std::move(graph_);
+    }
+
+  private:
+    int add(AlignmentNode node) {
+        graph_.nodes.push_back(node);
+        incoming_.emplace_back();
+        return static_cast<int>(graph_.nodes.size()) - 1;
+    }
+    void edge(int from, int to, float cost) { incoming_[to].push_back({from, cost}); }
+
+    // Edges into `to` from the end of the unit before it, and, skipping words, from earlier.
+    void fromPreviousUnits(int to, std::size_t unit) {
+        for (int skipped = 0; skipped <= kMaxSkippedInARow && skipped < static_cast<int>(unit);
+             ++skipped)
+            for (int from : units_[unit - 1 - skipped])
+                edge(from, to, config_.skipWordCost * static_cast<float>(skipped));
+    }
+
+    // The pause and filler before word `gap` (after the last word when gap == words).
+    void addGap(int gap) {
+        // Silence before and after the words is expected; between them it costs, and it lasts:
+        // a stop's closure at a word boundary is silent too, but short, and part of the stop.
+        const bool inner = gap > 0 && gap < graph_.words;
+        const int pauseFrames =
+            inner ? std::max(1, static_cast<int>(std::lround(config_.minPauseSeconds / hop_))) : 1;
+        AlignmentNode pause{AlignmentNode::Kind::Pause};
+        pause.phoneme = static_cast<int>(set_.silence());
+        pause.word = gap;
+        AlignmentNode filler{AlignmentNode::Kind::Filler};
+        filler.word = gap;
+        filler.loopCost = 0;  // its cost is per frame, in the emission
+        const int first = add(pause);
+        int last = first;
+        for (int k = 1; k < pauseFrames; ++k) {
+            const int n = add(pause);
+            edge(last, n, 0);
+            last = n;
+        }
+        graph_.nodes[last].loopCost = config_.silenceLoopCost;
+        const int f = add(filler);
+        // The unit a gap ends is the word before it (or the start): both join it.
+        const std::size_t unit = units_.size() - 1;
+        for (int node : {first, f}) {
+            const float enter = node == first && inner ? config_.pauseCost : 0.0f;
+            for (int from : units_[unit]) edge(from, node, enter);
+            for (int s = 1; s <= kMaxSkippedInARow && s <= static_cast<int>(unit); ++s)
+                for (int from : units_[unit - s])  // the words between skipped
+                    edge(from, node, enter + config_.skipWordCost * static_cast<float>(s));
+        }
+        edge(last, f, 0);  // a pause, then something else; edges only go forward
+        units_.back().push_back(last);
+        units_.back().push_back(f);
+    }
+
+    void addWord(const ScriptWord& word, int w) {
+        int previous = -1;
+        const double before = graph_.expectedSeconds;
+        for (const auto& seg : word.phonemes) {
+            const auto idx = set_.find(seg.phoneme);
+            if (!idx)
+                throw InputError("word '" + word.text + "': phoneme '" + seg.phoneme +
+                                 "' is not in the phoneme set");
+            if (*idx == set_.silence()) continue;  // pauses are the gaps' job
+            const double expected = std::max(hop_, seg.duration() * scale_) / hop_;
+            graph_.expectedSeconds += expected * hop_;
+            const double classMin =
+                (set_[*idx].vowel ? config_.minVowelSeconds : config_.minConsonantSeconds) / hop_;
+            const int chain = std::max(
+                1, static_cast<int>(
+                       std::lround(std::max(classMin, config_.minFractionOfExpected * expected))));
+            graph_.minimumFrames += chain;
+            const double stay =
+                std::clamp(1.0 - 1.0 / std::max(1.0, expected - chain + 1), kMinStay, kMaxStay);
+            for (int k = 0; k < chain; ++k) {
+                AlignmentNode node;
+                node.phoneme = static_cast<int>(*idx);
+                node.word = w;
+                node.phone = graph_.phones;
+                if (k + 1 == chain) {
+                    node.loopCost = static_cast<float>(-std::log(stay));
+                    node.exitCost = static_cast<float>(-std::log(1 - stay));
+                }
+                const int n = add(node);
+                if (previous >= 0)
+                    edge(previous, n, 0);
+                else
+                    fromPreviousUnits(n, units_.size());
+                previous = n;
+            }
+            ++graph_.phones;
+        }
+        if (previous < 0) throw InputError("word '" + word.text + "' has no phonemes to align");
+        units_.push_back({previous});
+        graph_.wordExpectedSeconds.push_back(graph_.expectedSeconds - before);
+    }
+
+    void flatten() {
+        const int n = static_cast<int>(graph_.nodes.size());
+        graph_.reach.assign(n, 0);
+        graph_.endCost.assign(n, kNever);
+        for (int to = 0; to < n; ++to) {
+            auto& node = graph_.nodes[to];
+            node.firstEdge = static_cast<int>(graph_.edges.size());
+            node.edgeCount = static_cast<int>(incoming_[to].size());
+            for (const auto& e : incoming_[to]) {
+                graph_.edges.push_back(e);
+                graph_.reach[e.from] = std::max(graph_.reach[e.from], to);
+            }
+        }
+        for (int i = 0; i < n; ++i) {
+            graph_.reach[i] = std::max(graph_.reach[i], i);
+            if (i > 0) graph_.reach[i] = std::max(graph_.reach[i], graph_.reach[i - 1]);
+        }
+        // Ending: after the last word, or with the last words skipped.
+        const std::size_t last = units_.size() - 1;
+        for (int s = 0; s <= kMaxSkippedInARow && s < static_cast<int>(last) + 1; ++s)
+            for (int node : units_[last - s])
+                if (graph_.nodes[node].kind != AlignmentNode::Kind::Start)
+                    graph_.endCost[node] = std::min(graph_.endCost[node],
+                                                    config_.skipWordCost * static_cast<float>(s));
+    }
+
+    const PhonemeSet& set_;
+    double hop_, scale_;
+    AlignerConfig config_;
+    AlignmentGraph graph_;
+    std::vector<std::vector<AlignmentEdge>> incoming_;
+    // Per unit (the start, then each word) the nodes a path leaves it from: the word's last
+    // node and the pause and filler after it.
+    std::vector<std::vector<int>> units_;
+};
+
+}  // namespace
+
+AlignmentGraph AlignmentGraph::build(std::span<const ScriptWord> script, const PhonemeSet& set,
+                                     double hopSeconds, double timeScale,
+                                     const AlignerConfig& config) {
+    if (script.empty()) throw InputError("forced alignment: no words to align");
+    if (!(hopSeconds > 0) || !(timeScale > 0) || !std::isfinite(timeScale))
+        throw InputError("forced alignment: hop and time scale must be positive");
+    return GraphBuilder(set, hopSeconds, timeScale, config).build(script);
+}
+
+}  // namespace lipsyncd::dsp

@@ -1,0 +1,46 @@
+// The state graph of a forced alignment: a start node; then, for every gap between words (and
+// before the first and after the last), an optional pause and an optional filler; and for every
+// phoneme of every word a chain of minimum-duration nodes, the last with a self-loop whose
+// probability gives the expected duration (a geometric tail; Rabiner 1989, section IV.D).
+// Nodes are in time order: every edge goes forward, so the Viterbi pass is one sweep.
+#pragma once
+
+#include <limits>
+#include <lipsyncd/dsp.hpp>
+#include <vector>
+
+namespace lipsyncd::dsp {
+
+inline constexpr float kNever = std::numeric_limits<float>::infinity();
+
+struct AlignmentNode {
+    enum class Kind { Start, Pause, Filler, Phoneme };
+    Kind kind = Kind::Phoneme;
+    int phoneme = 0;  // phoneme set index (Pause: silence)
+    int word = -1;    // word index (Phoneme) or the gap's index (Pause, Filler: before word)
+    int phone = -1;   // running index of the phoneme in the script (Phoneme)
+    float loopCost = kNever;           // staying another frame
+    float exitCost = 0;                // leaving (the tail's end probability)
+    int firstEdge = 0, edgeCount = 0;  // incoming edges
+};
+
+struct AlignmentEdge {
+    int from = 0;
+    float cost = 0;
+};
+
+struct AlignmentGraph {
+    std::vector<AlignmentNode> nodes;
+    std::vector<AlignmentEdge> edges;  // grouped by target node
+    std::vector<int> reach;            // reach[n]: the furthest node any node ≤ n leads to
+    std::vector<float> endCost;        // per node: cost of ending there (+inf: not an end)
+    int words = 0, phones = 0;
+    int minimumFrames = 0;       // the shortest path through every word
+    double expectedSeconds = 0;  // the synthesiser's durations, times the time scale
+    std::vector<double> wordExpectedSeconds;
+
+    static AlignmentGraph build(std::span<const ScriptWord> script, const PhonemeSet& set,
+                                double hopSeconds, double timeScale, const AlignerConfig& config);
+};
+
+}  // namespace lipsyncd::dsp

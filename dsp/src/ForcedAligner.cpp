@@ -1,0 +1,259 @@
+// Forced alignment by frame-synchronous Viterbi on the classifier's distances (the templates'
+// distances read as negative log-likelihoods: Rabiner 1989, section III.B), beam-pruned, with
+// the path committed in windows: every commitSeconds, the best path is traced back and the
+// part older than lookaheadSeconds becomes final; paths that disagree with it there are
+// dropped, so what was committed is never contradicted later.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "AlignmentGraph.hpp"
+#include "AlignmentPath.hpp"
+
+namespace lipsyncd::dsp {
+
+namespace {
+// A class without a template (distance +inf) costs as much as one this far off (dB).
+constexpr float kMissingClassDb = 12.0f;
+// In a frame below the energy gate, speech classes count as this much further off (dB).
+constexpr float kSilentExcessDb = 3.0f;
+}  // namespace
+
+struct ForcedAligner::State {
+    State(std::span<const ScriptWord> script, const PhonemeSet& s, double hopSeconds,
+          double timeScale, const AlignerConfig& c)
+        : graph(AlignmentGraph::build(script, s, hopSeconds, timeScale, c)),
+          set(&s),
+          hop(hopSeconds),
+          config(c),
+          path(script, graph, s, hopSeconds, c) {
+        const auto n = graph.nodes.size();
+        delta.assign(n, kNever);
+        next.assign(n, kNever);
+        delta[0] = 0;  // the start node, before the first frame
+        emission.assign(s.size(), 0);
+    }
+
+    // Per-frame data the window keeps: back-pointers for the active nodes, and the excess
+    // distances for the word confidences.
+    struct Row {
+        double time;
+        int lo, count;
+        std::size_t back, excess;  // offsets into back_, excess_
+    };
+
+    void scoreFrame(std::span<const float> distances, bool silent, std::vector<float>& excess);
+    void step();
+    int ancestor(std::int64_t frame, int node, std::int64_t atFrame) const;
+    void commit(std::int64_t keepFrames);
+    void emitPath(std::int64_t lastFrame, int node);
+    void dropFront(std::int64_t frames);
+    float emit(const AlignmentNode& n) const {
+        return n.kind == AlignmentNode::Kind::Filler ? config.fillerCostPerFrame
+                                                     : emission[n.phoneme];
+    }
+
+    AlignmentGraph graph;
+    const PhonemeSet* set;
+    double hop;
+    AlignerConfig config;
+    AlignmentPath path;
+    std::vector<float> delta, next, emission;
+    int lo = 0, hi = 0;  // active nodes after the last frame
+    std::vector<Row> rows;
+    std::vector<std::int32_t> back;
+    std::vector<float> excess;
+    std::int64_t windowStart = 0, frames = 0;
+    std::size_t peakRows = 0;
+    bool finished = false;
+};
+
+void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool silent,
+                                      std::vector<float>& excessOut) {
+    const std::size_t classes = set->size();
+    float nearest = kNever;
+    for (std::size_t c = 0; c < classes && c < distances.size(); ++c)
+        if (std::isfinite(distances[c])) nearest = std::min(nearest, distances[c]);
+    const auto sil = set->silence();
+    for (std::size_t c = 0; c < classes; ++c) {
+        const float d = c < distances.size() ? distances[c] : kNever;
+        float ex = 0;
+        if (std::isfinite(nearest)) ex = std::isfinite(d) ? d - nearest : kMissingClassDb;
+        float cost = config.distanceWeight * ex * (ex + 2 * (std::isfinite(nearest) ? nearest : 0));
+        if (silent || !std::isfinite(nearest)) {  // below the gate, or no spectrum at all
+            if (c == sil) {
+                cost = ex = 0;
+            } else {
+                cost +=
+                    (*set)[c].vowel ? config.speechInSilenceCost : config.consonantInSilenceCost;
+                ex += kSilentExcessDb;
+            }
+        }
+        emission[c] = cost;
+        excessOut.push_back(ex);
+    }
+}
+
+void ForcedAligner::State::step() {
+    const int from = lo, to = graph.reach[hi];
+    float best = kNever;
+    int bestNode = -1;
+    std::vector<std::int32_t>& bp = back;
+    const std::size_t offset = bp.size();
+    bp.resize(offset + static_cast<std::size_t>(to - from + 1), -1);
+    for (int n = from; n <= to; ++n) {
+        const auto& node = graph.nodes[n];
+        float in = kNever;
+        int arg = -1;
+        if (std::isfinite(node.loopCost) && delta[n] < kNever) {
+            in = delta[n] + node.loopCost;
+            arg = n;
+        }
+        for (int e = node.firstEdge; e < node.firstEdge + node.edgeCount; ++e) {
+            const auto& edge = graph.edges[e];
+            if (edge.from < lo || edge.from > hi) continue;
+            const float v = delta[edge.from] + graph.nodes[edge.from].exitCost + edge.cost;
+            if (v < in) {
+                in = v;
+                arg = edge.from;
+            }
+        }
+        if (arg < 0) continue;
+        next[n] = in + emit(node);
+        bp[offset + (n - from)] = arg;
+        if (next[n] < best) {
+            best = next[n];
+            bestNode = n;
+        }
+    }
+    // Pause and filler nodes loop at a finite cost, so some node is always reachable.
+    if (bestNode < 0) throw std::logic_error("forced alignment: no node reachable");
+    std::fill(delta.begin() + lo, delta.begin() + hi + 1, kNever);
+    // Keep what lies within the beam, and at most maxActiveNodes around the best.
+    const int half = std::max(1, config.maxActiveNodes / 2);
+    const int keepLo = std::max(from, bestNode - half), keepHi = std::min(to, bestNode + half);
+    int newLo = -1, newHi = -1;
+    for (int n = from; n <= to; ++n) {
+        if (n >= keepLo && n <= keepHi && next[n] <= best + config.beam) {
+            delta[n] = next[n];
+            if (newLo < 0) newLo = n;
+            newHi = n;
+        }
+        next[n] = kNever;
+    }
+    // Only the kept nodes' back-pointers can be followed later.
+    std::copy(bp.begin() + offset + (newLo - from), bp.begin() + offset + (newHi - from) + 1,
+              bp.begin() + offset);
+    bp.resize(offset + static_cast<std::size_t>(newHi - newLo + 1));
+    rows.back().lo = newLo;
+    rows.back().count = newHi - newLo + 1;
+    lo = newLo;
+    hi = newHi;
+}
+
+// The node a path in `node` at `frame` passed through at `atFrame` (≤ frame, in the window).
+int ForcedAligner::State::ancestor(std::int64_t frame, int node, std::int64_t atFrame) const {
+    for (std::int64_t f = frame; f > atFrame; --f) {
+        const auto& row = rows[static_cast<std::size_t>(f - windowStart)];
+        node = back[row.back + static_cast<std::size_t>(node - row.lo)];
+    }
+    return node;
+}
+
+void ForcedAligner::State::emitPath(std::int64_t lastFrame, int node) {
+    std::vector<int> nodes(static_cast<std::size_t>(lastFrame - windowStart + 1));
+    for (std::int64_t f = lastFrame; f >= windowStart; --f) {
+        nodes[static_cast<std::size_t>(f - windowStart)] = node;
+        if (f > windowStart) node = ancestor(f, node, f - 1);
+    }
+    const std::size_t classes = set->size();
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        const auto& row = rows[i];
+        path.add(row.time, nodes[i], std::span<const float>(excess).subspan(row.excess, classes));
+    }
+}
+
+void ForcedAligner::State::dropFront(std::int64_t count) {
+    const auto n = static_cast<std::size_t>(count);
+    if (n >= rows.size()) {
+        rows.clear();
+        back.clear();
+        excess.clear();
+    } else {
+        const auto b = rows[n].back, e = rows[n].excess;
+        rows.erase(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(n));
+        back.erase(back.begin(), back.begin() + static_cast<std::ptrdiff_t>(b));
+        excess.erase(excess.begin(), excess.begin() + static_cast<std::ptrdiff_t>(e));
+        for (auto& r : rows) {
+            r.back -= b;
+            r.excess -= e;
+        }
+    }
+    windowStart += count;
+}
+
+void ForcedAligner::State::commit(std::int64_t keepFrames) {
+    const std::int64_t last = frames - 1, upTo = last - keepFrames;
+    if (upTo < windowStart) return;
+    int bestNode = lo;
+    for (int n = lo; n <= hi; ++n)
+        if (delta[n] < delta[bestNode]) bestNode = n;
+    const int anchor = ancestor(last, bestNode, upTo);
+    emitPath(upTo, anchor);
+    for (int n = lo; n <= hi; ++n)
+        if (delta[n] < kNever && ancestor(last, n, upTo) != anchor) delta[n] = kNever;
+    while (lo < hi && !(delta[lo] < kNever)) ++lo;
+    while (hi > lo && !(delta[hi] < kNever)) --hi;
+    dropFront(upTo - windowStart + 1);
+}
+
+ForcedAligner::ForcedAligner(std::span<const ScriptWord> script, const PhonemeSet& set,
+                             double hopSeconds, double timeScale, const AlignerConfig& config)
+    : state_(std::make_unique<State>(script, set, hopSeconds, timeScale, config)) {}
+ForcedAligner::ForcedAligner(ForcedAligner&&) noexcept = default;
+ForcedAligner& ForcedAligner::operator=(ForcedAligner&&) noexcept = default;
+ForcedAligner::~ForcedAligner() = default;
+
+void ForcedAligner::push(double time, std::span<const float> distances, bool silent) {
+    auto& s = *state_;
+    if (s.finished) throw std::logic_error("ForcedAligner::push after finish");
+    s.rows.push_back({time, 0, 0, s.back.size(), s.excess.size()});
+    s.scoreFrame(distances, silent, s.excess);
+    s.step();
+    ++s.frames;
+    s.peakRows = std::max(s.peakRows, s.rows.size());
+    const auto keep = static_cast<std::int64_t>(std::lround(s.config.lookaheadSeconds / s.hop));
+    const auto every = static_cast<std::int64_t>(std::lround(s.config.commitSeconds / s.hop));
+    if (static_cast<std::int64_t>(s.rows.size()) >= keep + std::max<std::int64_t>(1, every))
+        s.commit(keep);
+}
+
+Alignment ForcedAligner::finish() {
+    auto& s = *state_;
+    s.finished = true;
+    if (s.frames == 0) return s.path.finish(false);
+    int endNode = -1, bestNode = s.lo;
+    float endBest = kNever;
+    for (int n = s.lo; n <= s.hi; ++n) {
+        if (s.delta[n] < s.delta[bestNode]) bestNode = n;
+        const float v = s.delta[n] + s.graph.endCost[n];
+        if (v < endBest) {
+            endBest = v;
+            endNode = n;
+        }
+    }
+    const bool complete = endNode >= 0;
+    // Without a path through the words, the best partial one still places the words it passed.
+    if (s.windowStart < s.frames) s.emitPath(s.frames - 1, complete ? endNode : bestNode);
+    return s.path.finish(complete);
+}
+
+double ForcedAligner::minimumSeconds() const {
+    return state_->graph.minimumFrames * state_->hop;
+}
+
+std::size_t ForcedAligner::peakFramesHeld() const {
+    return state_->peakRows;
+}
+
+}  // namespace lipsyncd::dsp

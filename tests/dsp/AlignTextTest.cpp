@@ -1,0 +1,217 @@
+// Known words aligned on espeak-ng speech (its own phoneme timings are the truth), with words
+// skipped, wrong words, music around the line, and bad input: never a crash, always either a
+// clear error or a flagged audio-only fallback.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <lipsyncd/dsp.hpp>
+#include <lipsyncd/tts.hpp>
+
+#include "TestSpeech.hpp"
+
+namespace lipsyncd {
+namespace {
+
+// Not in the training or dev corpus; a voice and rate the templates were not trained on.
+const std::string kLine = "Seven puppets sang a song about the moon.";
+
+struct Spoken {
+    std::vector<float> samples;
+    int rate = 0;
+    PhonemeSchedule labels;
+};
+
+// espeak-ng cannot be initialised again once terminated: one synthesiser for the process.
+EspeakSynthesizer& synth() {
+    static EspeakSynthesizer instance;
+    return instance;
+}
+
+Spoken speak(const std::string& text, const std::string& voice = "en-us+f3", int wpm = 150) {
+    const auto s = synth().synthesize({text, voice, wpm, -1});
+    Spoken out;
+    out.rate = s.sampleRate;
+    for (auto v : s.samples) out.samples.push_back(v / 32768.0f);
+    out.labels = mapSchedule(s.phonemes, espeakMapForVoice(voice), nullptr);
+    return out;
+}
+
+dsp::AlignFileResult align(const std::filesystem::path& file, const std::string& text) {
+    return alignText(synth(), file, text, "en-us", dsp::TemplateSet::loadDefault());
+}
+
+std::filesystem::path wav(const std::string& name, const std::vector<float>& samples, int rate) {
+    return test::writeAudio(name, samples, rate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+}
+
+// Per reference boundary: the distance to the nearest aligned boundary between the same
+// classes (0.1 s when there is none).
+std::vector<double> boundaryErrors(const PhonemeSchedule& hyp, const PhonemeSchedule& ref) {
+    std::vector<double> errors;
+    for (std::size_t i = 1; i < ref.size(); ++i) {
+        double best = 0.1;
+        for (std::size_t j = 1; j < hyp.size(); ++j)
+            if (hyp[j - 1].phoneme == ref[i - 1].phoneme && hyp[j].phoneme == ref[i].phoneme)
+                best = std::min(best, std::abs(hyp[j].start - ref[i].start));
+        errors.push_back(best);
+    }
+    std::sort(errors.begin(), errors.end());
+    return errors;
+}
+
+std::size_t placed(const dsp::AlignFileResult& r) {
+    return std::count_if(r.alignment.words.begin(), r.alignment.words.end(),
+                         [](const dsp::AlignedWord& w) { return w.placed; });
+}
+
+TEST(AlignText, EspeakSpeechBoundariesMatchItsOwnTimings) {
+    const auto s = speak(kLine);
+    const auto r = align(wav("align_line.wav", s.samples, s.rate), kLine);
+    EXPECT_FALSE(r.fellBack);
+    EXPECT_GE(placed(r), 7u);
+    // The aligner's own boundaries (before words it is unsure of get audio-only analysis).
+    const auto errors = boundaryErrors(r.alignment.schedule, s.labels);
+    ASSERT_GT(errors.size(), 20u);
+    EXPECT_LE(errors[errors.size() / 2], 0.015);       // median
+    EXPECT_LE(errors[errors.size() * 9 / 10], 0.050);  // 90th percentile
+    // The schedule covers the file without gaps.
+    EXPECT_DOUBLE_EQ(r.schedule.front().start, 0.0);
+    for (std::size_t i = 1; i < r.schedule.size(); ++i)
+        EXPECT_NEAR(r.schedule[i].start, r.schedule[i - 1].end, 1e-9);
+    EXPECT_NEAR(r.schedule.back().end, r.durationSeconds, 1e-9);
+}
+
+TEST(AlignText, WordsTheSpeakerSkippedAreNotPlacedAndSaid) {
+    const auto s = speak(kLine);
+    const auto r = align(wav("align_skip.wav", s.samples, s.rate),
+                         "Seven puppets sang a happy little song about the moon.");
+    EXPECT_FALSE(r.fellBack);
+    ASSERT_EQ(r.alignment.words.size(), 10u);
+    EXPECT_FALSE(r.alignment.words[4].placed);  // happy
+    EXPECT_FALSE(r.alignment.words[5].placed);  // little
+    EXPECT_GE(placed(r), 6u);
+    bool named = false;
+    for (const auto& w : r.warnings) named |= w.find("'happy'") != std::string::npos;
+    EXPECT_TRUE(named);
+}
+
+TEST(AlignText, MusicBeforeAndAfterTheLineIsLeftToAudioOnlyAnalysis) {
+    const auto s = speak(kLine);
+    std::vector<float> music;
+    auto addChord = [&](double seconds) {
+        for (int i = 0; i < static_cast<int>(seconds * s.rate); ++i) {
+            const double t = static_cast<double>(i) / s.rate;
+            music.push_back(static_cast<float>(
+                0.1 * (std::sin(2 * M_PI * 220 * t) + std::sin(2 * M_PI * 277 * t) +
+                       std::sin(2 * M_PI * 330 * t) + std::sin(2 * M_PI * 880 * t))));
+        }
+    };
+    addChord(1.0);
+    music.insert(music.end(), s.samples.begin(), s.samples.end());
+    addChord(1.0);
+    const auto r = align(wav("align_music.wav", music, s.rate), kLine);
+    EXPECT_FALSE(r.fellBack);
+    EXPECT_GE(placed(r), 6u);
+    EXPECT_GT(r.alignment.words.front().start, 0.9);
+    EXPECT_LT(r.alignment.words.back().end, r.durationSeconds - 0.9);
+}
+
+TEST(AlignText, TheWrongTextIsFlaggedNotForced) {
+    const auto s = speak(kLine);
+    const auto r =
+        align(wav("align_wrong.wav", s.samples, s.rate), "Fish chips vinegar sauce, which wish?");
+    EXPECT_LE(placed(r), 3u);  // of 6
+    EXPECT_FALSE(r.warnings.empty());
+    EXPECT_FALSE(r.schedule.empty());  // audio-only analysis stands in
+}
+
+TEST(AlignText, NumbersAreReadAsEspeakReadsThem) {
+    const auto script =
+        scriptForText(synth(), "I have 3 puppets", "en-us", espeakMapForVoice("en-us"), nullptr);
+    ASSERT_EQ(script.size(), 4u);
+    EXPECT_EQ(script[2].text, "3");
+    std::string phonemes;
+    for (const auto& p : script[2].phonemes) phonemes += p.phoneme + " ";
+    EXPECT_EQ(phonemes, "th r ih ");
+}
+
+TEST(AlignText, EmptyTextIsAnError) {
+    const auto s = speak(kLine);
+    const auto file = wav("align_empty.wav", s.samples, s.rate);
+    EXPECT_THROW(align(file, ""), InputError);
+    EXPECT_THROW(align(file, "  \n\t "), InputError);
+}
+
+TEST(AlignText, TextInAScriptTheVoiceCannotReadIsAnError) {
+    const auto s = speak(kLine);
+    const auto file = wav("align_script.wav", s.samples, s.rate);
+    try {
+        align(file, "日本語 Привет");
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("no words"), std::string::npos) << e.what();
+    }
+    // Mixed: the readable words are aligned, the others left to audio-only analysis.
+    const auto r = align(file, "Seven puppets Привет sang a song about the moon.");
+    EXPECT_GE(placed(r), 6u);
+    bool warned = false;
+    for (const auto& w : r.warnings) warned |= w.find("cannot read") != std::string::npos;
+    EXPECT_TRUE(warned);
+}
+
+TEST(AlignText, SilenceOnlyFallsBackWithAWarning) {
+    const auto r = align(wav("align_silence.wav", std::vector<float>(44100, 0.0f), 22050), kLine);
+    EXPECT_TRUE(r.fellBack);
+    EXPECT_EQ(placed(r), 0u);
+    ASSERT_FALSE(r.warnings.empty());
+    EXPECT_NE(r.warnings.front().find("no speech"), std::string::npos) << r.warnings.front();
+}
+
+TEST(AlignText, AudioFarShorterThanTheWordsFallsBackWithAWarning) {
+    const auto s = speak("Moon.");
+    const auto r = align(wav("align_short.wav", s.samples, s.rate),
+                         "Seven puppets sang a song about the moon, and then another song about "
+                         "the sun, the stars and the sea, and then they went to bed.");
+    EXPECT_TRUE(r.fellBack);
+    bool said = false;
+    for (const auto& w : r.warnings) said |= w.find("far shorter") != std::string::npos;
+    EXPECT_TRUE(said);
+    EXPECT_FALSE(r.schedule.empty());
+}
+
+// The service's path: a FILE.txt beside FILE.wav is used, and said so; without one, or with
+// words that cannot be used, the audio-only analysis.
+TEST(AlignText, WordsBesideAPlayedFileAreUsedAndLogged) {
+    const auto s = speak(kLine);
+    const auto file = wav("align_clip.wav", s.samples, s.rate);
+    auto words = file;
+    words.replace_extension(".txt");
+    std::filesystem::remove(words);
+    std::vector<std::string> log;
+    auto logger = [&](const std::string& line) { log.push_back(line); };
+    const auto templates = dsp::TemplateSet::loadDefault();
+    const auto audioOnly =
+        scheduleForClip(synth(), file, std::nullopt, "en-us", templates, {}, logger);
+    EXPECT_TRUE(log.empty());
+    EXPECT_EQ(audioOnly, dsp::analyzeFile(file, templates, PhonemeSet::common()).schedule);
+
+    std::ofstream(words) << kLine << '\n';
+    const auto aligned =
+        scheduleForClip(synth(), file, std::nullopt, "en-us", templates, {}, logger);
+    ASSERT_FALSE(log.empty());
+    EXPECT_NE(log.front().find(words.string()), std::string::npos) << log.front();
+    const auto errors = boundaryErrors(aligned, s.labels);
+    EXPECT_LE(errors[errors.size() / 2], 0.015);
+
+    log.clear();
+    std::ofstream(words) << "  \n";  // empty words: said, and audio-only analysis
+    EXPECT_EQ(scheduleForClip(synth(), file, std::nullopt, "en-us", templates, {}, logger),
+              audioOnly);
+    ASSERT_FALSE(log.empty());
+    EXPECT_NE(log.front().find("not used"), std::string::npos) << log.front();
+    std::filesystem::remove(words);
+}
+
+}  // namespace
+}  // namespace lipsyncd

@@ -1,0 +1,201 @@
+// Forced alignment on synthetic per-frame distances with known boundaries: the aligner must
+// find them, survive words the speaker skipped or sounds nobody scripted, and hold only a
+// bounded window of frames however long the input.
+#include <gtest/gtest.h>
+
+#include <lipsyncd/dsp.hpp>
+
+namespace lipsyncd::dsp {
+namespace {
+
+constexpr double kHop = 0.01;
+
+struct Run {
+    std::string phoneme;
+    int frames;
+};
+
+// Frames whose nearest class is the run's (4 dB) and every other class far (10 dB); silence
+// runs are below the energy gate.
+struct Frames {
+    std::vector<std::vector<float>> distances;
+    std::vector<bool> silent;
+    std::vector<double> boundaries;  // truth: where each run after the first starts
+
+    void add(const std::vector<Run>& runs) {
+        const auto& set = PhonemeSet::common();
+        for (const auto& r : runs) {
+            if (!distances.empty()) boundaries.push_back(distances.size() * kHop);
+            std::vector<float> d(set.size(), 10.0f);
+            d[*set.find(r.phoneme)] = 4.0f;
+            for (int i = 0; i < r.frames; ++i) {
+                distances.push_back(d);
+                silent.push_back(r.phoneme == "sil");
+            }
+        }
+    }
+    Alignment align(std::span<const ScriptWord> script, ForcedAligner* keep = nullptr) const {
+        ForcedAligner local(script, PhonemeSet::common(), kHop);
+        ForcedAligner& a = keep ? *keep : local;
+        for (std::size_t i = 0; i < distances.size(); ++i)
+            a.push((i + 0.5) * kHop, distances[i], silent[i]);
+        return a.finish();
+    }
+};
+
+// A word whose expected durations are 80 % of the true ones (the speaker is slower than the
+// synthesiser): the emissions, not the duration model, must place the boundaries.
+ScriptWord word(const std::string& text, const std::vector<Run>& runs) {
+    ScriptWord w{text, {}};
+    double t = 0;
+    for (const auto& r : runs) {
+        const double d = 0.8 * r.frames * kHop;
+        w.phonemes.push_back({t, t + d, r.phoneme, 1.0f});
+        t += d;
+    }
+    return w;
+}
+
+const std::vector<Run> kMama = {{"bmp", 6}, {"ah", 12}, {"bmp", 5}, {"ah", 10}};
+const std::vector<Run> kSee = {{"z", 8}, {"ih", 14}};
+const std::vector<Run> kWow = {{"w", 6}, {"aw", 15}, {"w", 7}};
+
+std::vector<ScriptWord> mamaSeeWow() {
+    return {word("mama", kMama), word("see", kSee), word("wow", kWow)};
+}
+
+void expectBoundariesAt(const PhonemeSchedule& s, const std::vector<double>& truth) {
+    ASSERT_EQ(s.size(), truth.size() + 1);
+    for (std::size_t i = 0; i < truth.size(); ++i)
+        EXPECT_NEAR(s[i + 1].start, truth[i], 1e-6)
+            << "boundary " << i << " (" << s[i].phoneme << " | " << s[i + 1].phoneme << ")";
+}
+
+TEST(ForcedAligner, FindsKnownBoundariesExactly) {
+    Frames f;
+    f.add({{"sil", 20}});
+    f.add(kMama);
+    f.add({{"sil", 15}});  // a pause between words
+    f.add(kSee);
+    f.add(kWow);
+    f.add({{"sil", 20}});
+    const auto script = mamaSeeWow();
+    const auto a = f.align(script);
+    EXPECT_TRUE(a.complete);
+    expectBoundariesAt(a.schedule, f.boundaries);
+    ASSERT_EQ(a.words.size(), 3u);
+    for (const auto& w : a.words) {
+        EXPECT_TRUE(w.placed) << w.text;
+        EXPECT_GT(w.confidence, 0.5f) << w.text;
+    }
+    EXPECT_NEAR(a.words[0].start, 0.20, 1e-6);
+    EXPECT_NEAR(a.words[1].start, 0.20 + 0.33 + 0.15, 1e-6);
+    EXPECT_TRUE(a.unexplained.empty());
+}
+
+TEST(ForcedAligner, AWordTheSpeakerSkippedIsNotPlaced) {
+    Frames f;
+    f.add({{"sil", 20}});
+    f.add(kMama);
+    f.add(kWow);  // "see" left out
+    f.add({{"sil", 20}});
+    const auto script = mamaSeeWow();
+    const auto a = f.align(script);
+    EXPECT_TRUE(a.complete);
+    EXPECT_TRUE(a.words[0].placed);
+    EXPECT_FALSE(a.words[1].placed);
+    EXPECT_TRUE(a.words[2].placed);
+    expectBoundariesAt(a.schedule, f.boundaries);
+}
+
+TEST(ForcedAligner, SoundsNobodyScriptedAreReportedAndTheWordsStillPlaced) {
+    Frames f;
+    f.add({{"sil", 20}});
+    f.add(kMama);
+    const double coughFrom = f.distances.size() * kHop;
+    f.add({{"kg", 6}, {"oy", 8}, {"f", 6}, {"th", 7}, {"kg", 5}, {"oy", 8}});  // not in the script
+    const double coughTo = f.distances.size() * kHop;
+    f.add(kSee);
+    f.add(kWow);
+    f.add({{"sil", 20}});
+    const auto script = mamaSeeWow();
+    const auto a = f.align(script);
+    for (const auto& w : a.words) EXPECT_TRUE(w.placed) << w.text;
+    EXPECT_NEAR(a.words[1].start, coughTo, 0.0101);
+    double covered = 0;
+    for (const auto& [from, to] : a.unexplained)
+        covered += std::max(0.0, std::min(to, coughTo) - std::max(from, coughFrom));
+    EXPECT_GT(covered, 0.8 * (coughTo - coughFrom));
+}
+
+TEST(ForcedAligner, LongInputIsAlignedInABoundedWindow) {
+    // 11 minutes of "mama see wow", 600 times over.
+    Frames f;
+    std::vector<ScriptWord> script;
+    for (int i = 0; i < 600; ++i) {
+        f.add({{"sil", 30}});
+        f.add(kMama);
+        f.add(kSee);
+        f.add(kWow);
+        for (auto& w : mamaSeeWow()) script.push_back(w);
+    }
+    f.add({{"sil", 30}});
+    AlignerConfig config;
+    ForcedAligner aligner(script, PhonemeSet::common(), kHop, 1.0, config);
+    const auto a = f.align(script, &aligner);
+    EXPECT_GT(f.distances.size(), 60000u);
+    EXPECT_LE(
+        aligner.peakFramesHeld(),
+        static_cast<std::size_t>((config.commitSeconds + config.lookaheadSeconds) / kHop) + 1);
+    EXPECT_TRUE(a.complete);
+    expectBoundariesAt(a.schedule, f.boundaries);
+    for (const auto& w : a.words) ASSERT_TRUE(w.placed) << w.text;
+}
+
+TEST(ForcedAligner, NoFramesMeansNoWordPlacedAndNoCrash) {
+    const auto script = mamaSeeWow();
+    ForcedAligner aligner(script, PhonemeSet::common(), kHop);
+    const auto a = aligner.finish();
+    EXPECT_FALSE(a.complete);
+    for (const auto& w : a.words) EXPECT_FALSE(w.placed);
+}
+
+TEST(ForcedAligner, TooFewFramesForTheWordsDoesNotCrash) {
+    Frames f;
+    f.add({{"bmp", 3}, {"ah", 3}});
+    std::vector<ScriptWord> script;
+    for (int i = 0; i < 20; ++i)
+        for (auto& w : mamaSeeWow()) script.push_back(w);
+    ForcedAligner aligner(script, PhonemeSet::common(), kHop);
+    EXPECT_GT(aligner.minimumSeconds(), 10 * f.distances.size() * kHop);
+    const auto a = f.align(script, &aligner);
+    EXPECT_FALSE(a.complete);
+    EXPECT_FALSE(a.words.back().placed);
+}
+
+TEST(ForcedAligner, FramesWithoutSpectraAreSilence) {
+    Frames f;
+    f.add(kMama);
+    f.distances.insert(
+        f.distances.begin(), 10,
+        std::vector<float>(PhonemeSet::common().size(), std::numeric_limits<float>::infinity()));
+    f.silent.insert(f.silent.begin(), 10, true);
+    const std::vector<ScriptWord> script = {word("mama", kMama)};
+    const auto a = f.align(script);
+    EXPECT_TRUE(a.words[0].placed);
+    EXPECT_NEAR(a.words[0].start, 0.10, 1e-6);
+}
+
+TEST(ForcedAligner, BadScriptsAreInputErrors) {
+    const auto& set = PhonemeSet::common();
+    EXPECT_THROW(ForcedAligner({}, set, kHop), InputError);
+    const std::vector<ScriptWord> unknown = {{"xyz", {{0, 0.1, "nope", 1.0f}}}};
+    EXPECT_THROW(ForcedAligner(unknown, set, kHop), InputError);
+    const std::vector<ScriptWord> silentWord = {{"...", {{0, 0.1, "sil", 1.0f}}}};
+    EXPECT_THROW(ForcedAligner(silentWord, set, kHop), InputError);
+    const auto script = mamaSeeWow();
+    EXPECT_THROW(ForcedAligner(script, set, kHop, 0.0), InputError);
+}
+
+}  // namespace
+}  // namespace lipsyncd::dsp

@@ -1,0 +1,57 @@
+// A played file's schedule: its known words aligned when the request or a FILE.txt beside it
+// gives them (issue 11), the audio-only analysis otherwise.
+#include <fstream>
+#include <lipsyncd/tts.hpp>
+#include <sstream>
+
+namespace lipsyncd {
+
+std::optional<std::filesystem::path> wordsBeside(const std::filesystem::path& audio) {
+    auto words = audio;
+    words.replace_extension(".txt");
+    std::error_code ec;
+    if (words == audio || !std::filesystem::is_regular_file(words, ec)) return std::nullopt;
+    return words;
+}
+
+namespace {
+std::optional<std::string> readWords(const std::filesystem::path& file,
+                                     const std::function<void(const std::string&)>& log) {
+    std::ifstream in(file);
+    if (!in) {
+        log(file.string() + ": cannot read the words file; audio-only analysis");
+        return std::nullopt;
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+}  // namespace
+
+PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
+                                const std::optional<std::string>& text, const std::string& voice,
+                                const dsp::TemplateSet& templates, const dsp::DecodeOptions& decode,
+                                const std::function<void(const std::string&)>& log) {
+    std::optional<std::string> words = text;
+    std::string source = "the request";
+    if (!words)
+        if (const auto beside = wordsBeside(audio)) {
+            words = readWords(*beside, log);
+            source = beside->string();
+        }
+    if (words) {
+        try {
+            const auto r = alignText(synth, audio, *words, voice, templates, {}, {}, decode);
+            log(audio.string() + ": words from " + source + " aligned" +
+                (r.fellBack ? " (fell back to audio-only analysis)" : ""));
+            for (const auto& w : r.warnings) log(audio.string() + ": " + w);
+            return r.schedule;
+        } catch (const InputError& e) {
+            log(audio.string() + ": words from " + source + " not used: " + e.what() +
+                "; audio-only analysis");
+        }
+    }
+    return dsp::analyzeFile(audio, templates, PhonemeSet::common(), {}, decode).schedule;
+}
+
+}  // namespace lipsyncd

@@ -1,0 +1,119 @@
+// Text → the script of a forced alignment, by espeak-ng's own reading of it (its word events
+// and phoneme events with their durations), through the same phoneme maps as `lipsync say`.
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <lipsyncd/tts.hpp>
+#include <string_view>
+
+namespace lipsyncd {
+
+namespace {
+// Languages written in Latin script. espeak-ng voices for them spell a word in another script
+// letter by letter (or name its characters), which is not what a speaker says.
+constexpr std::array<std::string_view, 36> kLatinScriptLanguages = {
+    "en", "de", "fr", "es", "it", "nl", "pt", "pl", "cs", "sv", "da", "nb",
+    "fi", "hu", "ro", "sk", "sl", "hr", "tr", "id", "ms", "vi", "ca", "eu",
+    "et", "lv", "lt", "af", "sw", "cy", "ga", "is", "sq", "eo", "la", "mt"};
+
+std::string languageOf(const std::string& voice) {
+    const auto base = voice.substr(0, voice.find('+'));
+    return base.substr(0, base.find('-'));
+}
+
+// Code points of UTF-8 text (invalid bytes count as one code point each).
+std::vector<char32_t> codePoints(std::string_view s) {
+    std::vector<char32_t> out;
+    for (std::size_t i = 0; i < s.size();) {
+        const auto b = static_cast<unsigned char>(s[i]);
+        const int extra = b >= 0xF0 ? 3 : b >= 0xE0 ? 2 : b >= 0xC0 ? 1 : 0;
+        char32_t c = extra ? b & (0x3F >> extra) : b;
+        std::size_t k = 1;
+        for (; k <= static_cast<std::size_t>(extra) && i + k < s.size(); ++k)
+            c = (c << 6) | (static_cast<unsigned char>(s[i + k]) & 0x3F);
+        out.push_back(c);
+        i += k;
+    }
+    return out;
+}
+
+// A letter outside Latin (Basic Latin to Latin Extended-B, and Latin Extended Additional);
+// general punctuation and symbols (U+2000..U+2BFF) are not letters.
+bool foreignToLatin(char32_t c) {
+    return c >= 0x250 && !(c >= 0x1E00 && c <= 0x1EFF) && !(c >= 0x2000 && c <= 0x2BFF);
+}
+
+bool readable(const std::string& word, const std::string& language) {
+    if (std::find(kLatinScriptLanguages.begin(), kLatinScriptLanguages.end(), language) ==
+        kLatinScriptLanguages.end())
+        return true;  // no rule for this language: trust espeak-ng
+    const auto cps = codePoints(word);
+    return std::none_of(cps.begin(), cps.end(), foreignToLatin);
+}
+
+void warn(std::vector<std::string>* warnings, std::string message) {
+    if (warnings) warnings->push_back(std::move(message));
+}
+
+dsp::ScriptWord mapWord(const SpokenWord& spoken, const PhonemeMap& map,
+                        std::vector<std::string>* warnings) {
+    dsp::ScriptWord word{spoken.text, {}};
+    for (const auto& p : spoken.phonemes) {
+        if (map.isIgnored(p.phoneme)) continue;
+        const auto r = map.map(p.phoneme);
+        if (!r) {
+            warn(warnings, "word '" + spoken.text + "': unknown phoneme '" + p.phoneme +
+                               "' (not in map " + map.name() + "); left out");
+            continue;
+        }
+        word.phonemes.push_back({p.start, p.end, r->phoneme, 1.0f});
+    }
+    return word;
+}
+
+bool hasSound(const dsp::ScriptWord& w) {
+    return std::any_of(w.phonemes.begin(), w.phonemes.end(),
+                       [](const PhonemeSegment& p) { return p.phoneme != "sil"; });
+}
+}  // namespace
+
+std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::string& text,
+                                           const std::string& voice, const PhonemeMap& map,
+                                           std::vector<std::string>* warnings) {
+    if (std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isspace(c) != 0; }))
+        throw InputError("the text to align is empty");
+    const auto speech = synth.synthesize({text, voice, 0, -1});
+    const auto language = languageOf(voice);
+    std::vector<dsp::ScriptWord> script;
+    for (const auto& spoken : speech.words) {
+        if (!readable(spoken.text, language)) {
+            warn(warnings, "word '" + spoken.text + "' is in a script voice '" + voice +
+                               "' cannot read (espeak-ng would spell it): left to audio-only "
+                               "analysis");
+            continue;
+        }
+        auto word = mapWord(spoken, map, warnings);
+        if (hasSound(word)) script.push_back(std::move(word));
+    }
+    if (script.empty())
+        throw InputError("espeak-ng (voice '" + voice + "') found no words it can read in '" +
+                         text + "'");
+    return script;
+}
+
+dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::path& audio,
+                               const std::string& text, const std::string& voice,
+                               const dsp::TemplateSet& templates,
+                               const dsp::FrontEndConfig& frontEnd,
+                               const dsp::AlignerConfig& aligner, const dsp::DecodeOptions& decode,
+                               const std::optional<dsp::RawFormat>& raw) {
+    const auto map = espeakMapForVoice(voice);
+    const auto& set = PhonemeSet::named(map.phonemeSet());
+    std::vector<std::string> warnings;
+    const auto script = scriptForText(synth, text, voice, map, &warnings);
+    auto result = dsp::alignFile(audio, script, templates, set, frontEnd, aligner, decode, raw);
+    result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
+    return result;
+}
+
+}  // namespace lipsyncd
