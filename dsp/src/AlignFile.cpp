@@ -148,6 +148,8 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
         aligner.push(f.label.time, analyzer.distances(), f.label.silent);
         speechFrames += !f.label.silent;
+        if (r.levels.db.empty()) r.levels.start = f.label.time;
+        r.levels.db.push_back(f.label.energyDb);
     });
     analyzer.onSegment([&](const PhonemeSegment& s) { r.audioOnly.push_back(s); });
     std::vector<float> block(kReadBlock);
@@ -160,6 +162,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     r.durationSeconds = static_cast<double>(total) / decoder.sampleRate();
     if (!r.audioOnly.empty()) r.audioOnly.back().end = r.durationSeconds;
     r.alignment = aligner.finish();
+    r.levels.rate = 1 / templates.analysis.hopSeconds;
 
     const std::string name = decoder.name();
     if (speechFrames == 0) {

@@ -648,6 +648,7 @@ class ForcedAligner {
 struct AlignFileResult {
     PhonemeSchedule schedule;  // aligned where words were placed, audio-only elsewhere
     PhonemeSchedule audioOnly;  // the front end's own schedule (analyzeFile)
+    LevelTrack levels;          // every frame's RMS level (dBFS): how wide the mouth opens
     Alignment alignment;
     double durationSeconds = 0, timeScale = 1;
     std::vector<std::string> warnings;  // unplaced words, fallbacks: for the user
