@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Replays a small subset of the real dev speakers (config/corpus/real-speakers.txt) through
-# `lipsync eval`, one run per speaker, each against its own floor (visual-group accuracy).
+# `lipsync eval`, one run per speaker, each against its own floors: visual-group accuracy and
+# the jaw-servo puppet's jaw r from the audio; for every speaker the jaw from the exact labels
+# must reach r 0.92 and catch 95 % of the bilabial closures.
 #
-#   real-dev-replay.sh LIPSYNC OUT_DIR SUBSET SPEAKER=FLOOR...
+#   real-dev-replay.sh LIPSYNC OUT_DIR SUBSET SPEAKER=GROUP_FLOOR:JAW_FLOOR...
 #
 # Exits 77 (ctest: skipped) only when scripts/fetch-real-speech.sh cannot fetch the packages
 # or tools; any other failure fails the test.
@@ -19,9 +21,11 @@ fi
 [ "$rc" -eq 0 ] || exit "$rc"
 failed=0
 for pair in "$@"; do
-  speaker="${pair%%=*}" floor="${pair#*=}"
-  echo "== $speaker (floor: visual groups $floor)"
-  "$lipsync" eval --corpus "$out/dev/$speaker" --no-per-file --min-group-accuracy "$floor" |
+  speaker="${pair%%=*}" floors="${pair#*=}"
+  group="${floors%%:*}" jaw="${floors#*:}"
+  echo "== $speaker (floors: visual groups $group, jaw r from audio $jaw)"
+  "$lipsync" eval --corpus "$out/dev/$speaker" --no-per-file --min-group-accuracy "$group" \
+    --min-jaw-r "$jaw" --min-exact-jaw-r 0.92 --min-exact-closures 0.95 |
     tail -2 || failed=1
 done
 exit "$failed"
