@@ -10,10 +10,13 @@
 //   Player         the queue: plays clips one after another through the sink and drives the
 //                  puppet at the sink's clock plus the puppet's lead time and the sync offset.
 //   ControlServer  a Unix socket speaking JSON lines to many clients at once.
+//   ControlCommand the protocol's one command table (names, argument types, limits), shared
+//                  by the daemon, `lipsync ctl` and the tests; ControlClient is their client.
 //   Daemon         all of it in one poll() loop with sd_notify (READY, STATUS, WATCHDOG,
 //                  RELOADING, STOPPING), SIGHUP reload and SIGTERM rest-then-exit.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
@@ -24,6 +27,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace lipsyncd {
@@ -55,10 +59,66 @@ struct DaemonConfig {
     // [control]
     std::filesystem::path socket = "/run/lipsyncd/control.sock";
     unsigned socketMode = 0660;
+    std::size_t maxClients = 16;  // more get {"ok": false, "error": "too many clients"}
     double outputRateHz = 100;
+    // [limits]: what one request may cost (memory, the worker's time).
+    double maxClipSeconds = 30;
+    std::size_t maxTextBytes = 600;
+    std::size_t maxQueue = 8;
 
     static DaemonConfig load(const std::filesystem::path& file);  // InputError with file:line
 };
+
+// ---------------------------------------------------------------------------------------------
+// The control protocol: one JSON object per line, {"cmd": NAME, ARG: value, ...}; one reply per
+// request, {"ok": true, ...} or {"ok": false, "error": "..."}.
+
+struct ControlArg {
+    enum class Type { String, Path, Boolean, Integer };  // Path: a string the client makes absolute
+    std::string_view name;
+    Type type;
+    bool required;
+    std::size_t maxLength;  // strings: bytes
+    long min, max;          // integers
+    std::string_view help;
+};
+
+struct ControlCommand {
+    std::string_view name;
+    std::string_view usage;       // "play FILE: queue an audio file"
+    std::string_view positional;  // the argument `lipsync ctl NAME WORDS...` fills, or ""
+    std::span<const ControlArg> args;
+};
+
+std::span<const ControlCommand> controlCommands();
+const ControlCommand* findControlCommand(std::string_view name);  // nullptr when unknown
+std::string controlCommandNames();                                // "live, play, ..."
+// nullopt when `request` fits the table; otherwise why not, naming the command and argument.
+std::optional<std::string> checkControlRequest(const nlohmann::json& request);
+
+// A client of the control socket with a deadline on every step (connect, write, each reply):
+// a daemon that does not answer is an error, never a hang.
+class ControlClient {
+  public:
+    // InputError naming the socket when nothing listens there.
+    ControlClient(const std::filesystem::path& socket, std::chrono::milliseconds timeout);
+    ~ControlClient();
+    ControlClient(const ControlClient&) = delete;
+    ControlClient& operator=(const ControlClient&) = delete;
+
+    nlohmann::json request(const nlohmann::json& request);  // send, then the next reply
+    void sendRaw(std::string_view bytes);                    // any bytes (tests send bad ones)
+    std::string readLine();  // the next line; std::runtime_error on timeout or a closed socket
+
+  private:
+    void waitFor(short events, const char* what) const;
+    int fd_ = -1;
+    std::chrono::milliseconds timeout_;
+    std::string buffer_;
+    std::filesystem::path socket_;
+};
+
+// ---------------------------------------------------------------------------------------------
 
 class AudioSink {
   public:
