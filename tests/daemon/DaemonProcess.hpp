@@ -72,7 +72,12 @@ class Client {
     }
     bool connected() const { return c_.has_value(); }
     void sendLine(const std::string& line) { sendRaw(line + "\n"); }
-    void sendRaw(const std::string& bytes) { c_->sendRaw(bytes); }
+    void sendRaw(const std::string& bytes) {
+        try {
+            c_->sendRaw(bytes);
+        } catch (const std::runtime_error&) {  // closed by the daemon: readLine says so
+        }
+    }
     // The next line; "" when the daemon closed the connection or did not answer.
     std::string readLine() {
         try {
@@ -96,6 +101,22 @@ struct DaemonProcess {
             << "[audio]\ndevice = \"" << device << "\"\n[mouth]\npuppet = \"terminal\"\n"
             << "hardware = false\nrecord = \"" << (dir / "rec.csv").string() << "\"\n"
             << extraMouth << "[control]\nsocket = \"" << (dir / "control.sock").string() << "\"\n";
+    }
+    // More config after the [control] section: its keys, or new sections.
+    void append(const std::string& toml) const {
+        std::ofstream(dir / "lipsyncd.toml", std::ios::app) << toml << "\n";
+    }
+    fs::path socket() const { return dir / "control.sock"; }
+    std::string log() const { return slurp(dir / "stderr.log"); }
+    // CPU seconds the daemon has used (user + system).
+    double cpuSeconds() const {
+        std::ifstream s("/proc/" + std::to_string(pid) + "/stat");
+        std::string field;
+        for (int i = 1; i <= 13 && s >> field; ++i) {
+        }
+        long user = 0, sys = 0;
+        s >> user >> sys;
+        return static_cast<double>(user + sys) / static_cast<double>(::sysconf(_SC_CLK_TCK));
     }
     void start() {
         ::setenv("NOTIFY_SOCKET", (dir / "notify").c_str(), 1);

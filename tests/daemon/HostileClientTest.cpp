@@ -81,14 +81,13 @@ TEST(HostileClient, AnotherClientsErrorsNeverReachASubscriber) {
     Client watcher(d.dir / "control.sock"), vandal(d.dir / "control.sock");
     ASSERT_TRUE(watcher.connected() && vandal.connected());
     ASSERT_TRUE(watcher.request({{"cmd", "subscribe"}})["ok"]);
-    ASSERT_TRUE(watcher.request({{"cmd", "say"}, {"text", "Hello there."}})["ok"]);
+    ASSERT_TRUE(vandal.request({{"cmd", "say"}, {"text", "Hello there."}})["ok"]);
     for (const auto* line : {"\xff", R"({"cmd":"subscribe","on":"x"})", "{broken", "[1]"})
         vandal.sendLine(line);
     for (int i = 0; i < 20; ++i) {
         const auto line = watcher.readLine();
         ASSERT_FALSE(line.empty()) << "the subscriber's connection ended";
         const auto j = json::parse(line, nullptr, false);
-        if (j.contains("ok")) continue;  // the reply to say, when it comes after events
         EXPECT_EQ(j["event"], "frame") << line;
     }
     EXPECT_TRUE(d.running());
