@@ -40,7 +40,8 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
             mouth->fail("runtime", "must be \"bigram\" or \"filter\"");
         c.templates = mouth->optString("templates").value_or("");
         c.voice = mouth->optString("voice").value_or(c.voice);
-        c.leadSeconds = seconds(*mouth, "lead", c.leadSeconds, -1, 1);
+        if (mouth->optNumber("lead"))
+            mouth->fail("lead", "belongs to the puppet file now (lead = SECONDS: its servo lag)");
         c.syncOffsetSeconds = seconds(*mouth, "sync_offset", 0, -2, 2);
         c.hardware = mouth->optBool("hardware").value_or(true);
         c.record = mouth->optString("record").value_or("");

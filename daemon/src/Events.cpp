@@ -24,9 +24,16 @@ json Daemon::Impl::frameEvent(double t) const {
 json Daemon::Impl::statusReply() const {
     const auto* clip = player.clip();
     const auto& config = setup->config;
+    // End to end: a clip's sample handed to the device until it is heard (the mouth is driven
+    // `lead` ahead of it, so the servo arrives with it); live, a sound at the microphone until
+    // the mouth has moved: the front end's bound, a tick, and the servo's lag.
+    const double lead = setup->puppet->leadSeconds;
+    const double tickSeconds = 0.01;
     json latency = {{"audio_delay", player.clock().delay},
-                    {"lead", config.leadSeconds},
-                    {"sync_offset", config.syncOffsetSeconds}};
+                    {"lead", lead},
+                    {"sync_offset", config.syncOffsetSeconds},
+                    {"end_to_end", live ? live->frontEndLatency() + tickSeconds + lead
+                                        : player.clock().delay}};
     return {{"ok", true},
             {"playing", clip ? json(clip->name) : json(nullptr)},
             {"position", player.clock().heard},

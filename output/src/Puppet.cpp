@@ -173,6 +173,7 @@ Puppet Puppet::load(const std::filesystem::path& file) {
     p.name = root.getString("name");
     p.description = root.optString("description").value_or("");
     p.stallTimeout = number(root, "stall_timeout", 0.5, 0.01, 3600);
+    p.leadSeconds = number(root, "lead", 0, 0, 1);
     for (const auto& h : root.tableArray("hid")) p.hidDevices.push_back(readHid(h));
     for (const auto& t : root.tableArray("actuator")) p.actuators.push_back(readActuator(t));
     root.finish();

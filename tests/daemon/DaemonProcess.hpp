@@ -96,9 +96,10 @@ struct DaemonProcess {
     fs::path dir = scratchDir("daemon");
     pid_t pid = -1;
 
-    explicit DaemonProcess(const std::string& extraMouth = "", const std::string& device = "null") {
+    explicit DaemonProcess(const std::string& extraMouth = "", const std::string& device = "null",
+                           const std::string& puppet = "terminal") {
         std::ofstream(dir / "lipsyncd.toml")
-            << "[audio]\ndevice = \"" << device << "\"\n[mouth]\npuppet = \"terminal\"\n"
+            << "[audio]\ndevice = \"" << device << "\"\n[mouth]\npuppet = \"" << puppet << "\"\n"
             << "hardware = false\nrecord = \"" << (dir / "rec.csv").string() << "\"\n"
             << extraMouth << "[control]\nsocket = \"" << (dir / "control.sock").string() << "\"\n";
     }

@@ -64,7 +64,7 @@ TEST(Daemon, MalformedConfigStopsStartupWithTheLine) {
 }
 
 TEST(Daemon, PlayedFileDrivesTheMouthAsTheOfflinePassDoes) {
-    DaemonProcess d("lead = 0.0\n", "file:" + (scratchDir("daemon_audio") / "out.wav").string());
+    DaemonProcess d("", "file:" + (scratchDir("daemon_audio") / "out.wav").string());
     d.start();
     Client c(d.dir / "control.sock");
     ASSERT_TRUE(c.connected());

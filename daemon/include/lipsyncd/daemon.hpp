@@ -48,7 +48,7 @@ struct DaemonConfig {
     std::string runtime = "bigram";  // bigram | filter
     std::string templates;           // empty: the shipped default
     std::string voice = "en-us";
-    double leadSeconds = 0.05;     // drive the mouth this much ahead of the sound (servo lag)
+    // (The lead that makes up for servo lag belongs to the puppet file: Puppet::leadSeconds.)
     double syncOffsetSeconds = 0;  // the user's correction, + moves the mouth later
     bool hardware = true;          // open the puppet's GPIO/HID outputs
     std::string record;            // also record every actuator command here (CSV)
