@@ -25,12 +25,13 @@ constexpr int kChunksPerPass = 16;
 constexpr int kBacklog = 64;
 constexpr auto kAcceptPause = std::chrono::milliseconds(100);
 
+}  // namespace
+
 // Replies are always valid JSON: text that is not UTF-8 (a request's bad byte quoted in an
 // error, a name from a file) is replaced, never thrown on.
-std::string serialise(const nlohmann::json& j) {
+std::string ControlServer::serialise(const nlohmann::json& j) {
     return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
-}  // namespace
 
 // An existing path is left alone unless it is a socket nobody answers on (a crashed run's):
 // a live daemon's socket is refused, anything else (a file, a folder) is never removed.
@@ -95,7 +96,7 @@ void ControlServer::service(const Handler& handle) {
     for (auto& c : clients_) {
         readFrom(c, [&](const std::string& line) {
             if (line.find_first_not_of(" \t\r") == std::string::npos) return;
-            c.out += serialise(reply(line, c, handle));
+            c.out += serialise(reply(line, c.subscribed, handle));
         });
         flush(c);
     }
@@ -151,7 +152,7 @@ void ControlServer::setMaxClients(std::size_t n) {
     maxClients_ = n;
 }
 
-nlohmann::json ControlServer::reply(const std::string& line, Client& client,
+nlohmann::json ControlServer::reply(const std::string& line, bool& subscribed,
                                     const Handler& handle) {
     nlohmann::json request;
     try {
@@ -161,8 +162,8 @@ nlohmann::json ControlServer::reply(const std::string& line, Client& client,
     }
     if (const auto bad = checkControlRequest(request)) return {{"ok", false}, {"error", *bad}};
     if (request["cmd"] == "subscribe") {
-        client.subscribed = request.value("on", true);
-        return {{"ok", true}, {"subscribed", client.subscribed}};
+        subscribed = request.value("on", true);
+        return {{"ok", true}, {"subscribed", subscribed}};
     }
     // Whatever goes wrong with one request is that request's reply, never the daemon's exit.
     try {

@@ -29,6 +29,9 @@ class ControlServer {
     void service(const Handler& handle);          // accept, read, answer, write: never blocks
     void broadcast(const nlohmann::json& event);  // to subscribers
     std::size_t clients() const;
+    // One request line's reply (subscribe sets `subscribed`); never throws.
+    static nlohmann::json reply(const std::string& line, bool& subscribed, const Handler& handle);
+    static std::string serialise(const nlohmann::json& reply);  // one line, always valid JSON
     void setMaxClients(std::size_t n);
     const std::filesystem::path& path() const { return path_; }
 
@@ -41,7 +44,7 @@ class ControlServer {
         bool discarding = false;  // inside a line that was too long: dropped up to its newline
     };
     using LineHandler = std::function<void(const std::string&)>;
-    nlohmann::json reply(const std::string& line, Client& client, const Handler& handle);
+
     void readFrom(Client& c, const LineHandler& onLine);
     void take(Client& c, std::string_view bytes, const LineHandler& onLine);
     void flush(Client& c);

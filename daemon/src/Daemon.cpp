@@ -116,6 +116,17 @@ json Daemon::handle(const json& request) {
     return impl_->handle(request);
 }
 
+std::string Daemon::answer(const std::string& line) {
+    bool subscribed = false;
+    return ControlServer::serialise(
+        ControlServer::reply(line, subscribed, [this](const json& r) { return impl_->handle(r); }));
+}
+
+void Daemon::tickOnce() {
+    impl_->tick();
+    impl_->reportFailures();
+}
+
 int Daemon::run() {
     auto& d = *impl_;
     sigset_t signals;

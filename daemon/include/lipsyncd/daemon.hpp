@@ -185,6 +185,11 @@ class Daemon {
     int run();
     // One JSON request, one JSON reply (the socket's protocol; public for tests).
     nlohmann::json handle(const nlohmann::json& request);
+    // The socket's protocol without the socket (fuzzing, tests): one request line in, the
+    // reply line out, through the same checks a connection's lines go through.
+    std::string answer(const std::string& line);
+    // One pass of the loop's work without its timer: a tick, and failures reported.
+    void tickOnce();
 
   private:
     struct Impl;
