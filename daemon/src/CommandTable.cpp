@@ -96,7 +96,9 @@ std::optional<std::string> checkControlRequest(const nlohmann::json& request) {
     const auto& name = request["cmd"].get_ref<const std::string&>();
     const auto* command = findControlCommand(name);
     if (!command) return "unknown cmd '" + name + "' (" + controlCommandNames() + ")";
-    for (const auto& [key, value] : request.items()) {
+    for (const auto& item : request.items()) {
+        const auto& key = item.key();
+        const auto& value = item.value();
         if (key == "cmd") continue;
         const auto arg = std::find_if(command->args.begin(), command->args.end(),
                                       [&](const ControlArg& a) { return a.name == key; });

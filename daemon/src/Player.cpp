@@ -17,9 +17,22 @@ void Player::start(Clip clip, AudioSink& audio) {
     frame_.assign(clip_->weights.poses.size(), 0.0f);
 }
 
+// The device takes floats: 16-bit samples are converted a block at a time into a fixed
+// buffer (no allocation in the tick), until the device takes less than it is offered.
+void Player::write(AudioSink& audio) {
+    const auto& s = clip_->samples;
+    while (written_ < s.size()) {
+        const auto n = std::min(block_.size(), s.size() - written_);
+        for (std::size_t i = 0; i < n; ++i) block_[i] = static_cast<float>(s[written_ + i]) / 32768.0f;
+        const auto taken = audio.write(std::span<const float>(block_).first(n));
+        written_ += taken;
+        if (taken < n) return;
+    }
+}
+
 std::span<const float> Player::tick(AudioSink& audio, double leadSeconds, double outputRateHz) {
     if (!clip_) return {};
-    written_ += audio.write(std::span<const float>(clip_->samples).subspan(written_));
+    write(audio);
     const auto heardSamples = audio.played() - base_;  // the one clock read of this tick
     const double rate = clip_->rate;
     clock_ = {static_cast<double>(heardSamples) / rate,

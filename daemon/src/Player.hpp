@@ -3,6 +3,7 @@
 // picks the pose-weight frame the mouth shows at that clock plus the puppet's lead.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <lipsyncd/daemon.hpp>
 #include <optional>
@@ -34,7 +35,10 @@ class Player {
     std::span<const float> frame() const { return frame_; }  // the frame last shown
 
   private:
+    void write(AudioSink& audio);
+
     std::optional<Clip> clip_;
+    std::array<float, 2048> block_{};
     std::size_t written_ = 0;  // samples handed to the device
     std::int64_t base_ = 0;    // the device's position when the clip started
     AudioClock clock_;

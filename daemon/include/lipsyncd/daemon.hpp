@@ -145,7 +145,7 @@ std::unique_ptr<CaptureSource> openCaptureSource(const std::string& device, int 
 
 struct Clip {
     std::string name;
-    std::vector<float> samples;  // mono
+    std::vector<std::int16_t> samples;  // mono, 16-bit: half a float's memory (max_queue)
     int rate = 0;
     PoseTrack weights;
 };
