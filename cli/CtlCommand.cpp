@@ -63,8 +63,9 @@ nlohmann::json requestFrom(const CtlOptions& o) {
         throw CLI::ValidationError("ctl", "unknown command '" + a.front() + "'\n" + usage());
     nlohmann::json r = {{"cmd", a.front()}};
     if (!command->positional.empty() && a.size() > 1) {
-        const auto& arg = *std::find_if(command->args.begin(), command->args.end(),
-                                        [&](const ControlArg& x) { return x.name == command->positional; });
+        const auto& arg =
+            *std::find_if(command->args.begin(), command->args.end(),
+                          [&](const ControlArg& x) { return x.name == command->positional; });
         if (arg.type == ControlArg::Type::String) {  // words join into one text
             std::string text;
             for (std::size_t i = 1; i < a.size(); ++i) text += (i > 1 ? " " : "") + a[i];
@@ -85,7 +86,8 @@ nlohmann::json requestFrom(const CtlOptions& o) {
 
 void runCtl(const CtlOptions& o) {
     const auto request = requestFrom(o);
-    daemon::ControlClient c(o.socket, std::chrono::milliseconds(static_cast<long>(o.timeout * 1000)));
+    daemon::ControlClient c(o.socket,
+                            std::chrono::milliseconds(static_cast<long>(o.timeout * 1000)));
     const auto reply = c.request(request);
     std::cout << reply.dump() << std::endl;
     if (!reply.value("ok", false))
@@ -104,8 +106,8 @@ void runCtl(const CtlOptions& o) {
 
 void addCtlCommand(CLI::App& app) {
     auto o = std::make_shared<CtlOptions>();
-    auto* cmd = app.add_subcommand("ctl", "Talk to a running lipsyncd: " +
-                                              daemon::controlCommandNames() + ", raw JSON");
+    auto* cmd = app.add_subcommand(
+        "ctl", "Talk to a running lipsyncd: " + daemon::controlCommandNames() + ", raw JSON");
     cmd->footer(usage());
     cmd->add_option("--socket", o->socket, "lipsyncd's control socket")->capture_default_str();
     cmd->add_option("--channel", o->channel, "play: analyse only this channel of the file");

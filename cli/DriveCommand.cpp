@@ -53,8 +53,8 @@ void runDrive(const DriveOptions& o) {
     const auto waitUntil = [&](double t) {
         // The puppet's lead: each frame goes out that much before its time (servo lag).
         if (o.realtime)
-            std::this_thread::sleep_until(
-                start + std::chrono::duration<double>(t - puppet.leadSeconds));
+            std::this_thread::sleep_until(start +
+                                          std::chrono::duration<double>(t - puppet.leadSeconds));
     };
     double t = 0;
     bool stalled = false;

@@ -55,7 +55,8 @@ std::vector<std::int16_t> decodeForPlayback(const std::filesystem::path& file,
     std::array<float, 4096> block{};
     while (const auto n = decoder.read(block))
         for (std::size_t i = 0; i < n; ++i)
-            out.push_back(static_cast<std::int16_t>(std::lround(std::clamp(block[i], -1.0f, 1.0f) * 32767.0f)));
+            out.push_back(static_cast<std::int16_t>(
+                std::lround(std::clamp(block[i], -1.0f, 1.0f) * 32767.0f)));
     return out;
 }
 }  // namespace

@@ -31,8 +31,8 @@ double checkAudioFile(const std::filesystem::path& file, double maxSeconds) {
 void checkText(const std::string& text, std::size_t maxBytes) {
     if (text.size() > maxBytes)
         throw InputError("say: " + std::to_string(text.size()) +
-                         " bytes of text is more than max_text_bytes (" +
-                         std::to_string(maxBytes) + " in the config)");
+                         " bytes of text is more than max_text_bytes (" + std::to_string(maxBytes) +
+                         " in the config)");
 }
 
 Clip prepareClip(const ClipRequest& request, std::unique_ptr<EspeakSynthesizer>& synth) {

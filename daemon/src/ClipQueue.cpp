@@ -6,7 +6,6 @@
 
 #include <csignal>
 #include <functional>
-
 #include <lipsyncd/tts.hpp>
 #include <utility>
 

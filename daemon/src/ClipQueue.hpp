@@ -18,14 +18,14 @@ namespace lipsyncd::daemon {
 
 // One play or say request, checked and bounded, not yet prepared.
 struct ClipRequest {
-    std::string name;             // as status shows it
-    std::filesystem::path file;   // play: a regular audio file (empty for say)
-    int channel = -1;             // play: the voice channel, -1: the mix
-    std::string text, voice;      // say
+    std::string name;            // as status shows it
+    std::filesystem::path file;  // play: a regular audio file (empty for say)
+    int channel = -1;            // play: the voice channel, -1: the mix
+    std::string text, voice;     // say
     // The words spoken in `file`, when known (a script beside the file, or play's text
     // argument): preparation passes them on to alignment instead of recognition.
     std::optional<std::string> knownText;
-    double maxSeconds = 30;       // the config's limit on a clip's length
+    double maxSeconds = 30;                  // the config's limit on a clip's length
     std::shared_ptr<const ClipMaker> maker;  // the config's pieces when it was asked for
 };
 

@@ -102,8 +102,7 @@ std::optional<std::string> checkControlRequest(const nlohmann::json& request) {
         if (key == "cmd") continue;
         const auto arg = std::find_if(command->args.begin(), command->args.end(),
                                       [&](const ControlArg& a) { return a.name == key; });
-        if (arg == command->args.end())
-            return name + ": unknown argument \"" + key + "\"";
+        if (arg == command->args.end()) return name + ": unknown argument \"" + key + "\"";
         if (auto bad = checkArg(*command, *arg, value)) return bad;
     }
     for (const auto& a : command->args)

@@ -12,8 +12,7 @@
 
 namespace lipsyncd::daemon {
 
-ControlClient::ControlClient(const std::filesystem::path& socket,
-                             std::chrono::milliseconds timeout)
+ControlClient::ControlClient(const std::filesystem::path& socket, std::chrono::milliseconds timeout)
     : timeout_(timeout), socket_(socket) {
     sockaddr_un addr{};
     if (socket.string().size() >= sizeof(addr.sun_path))
@@ -58,8 +57,8 @@ void ControlClient::sendRaw(std::string_view bytes) {
         } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
             waitFor(POLLOUT, "write");
         } else {
-            throw std::runtime_error(socket_.string() + ": write failed (" +
-                                     std::strerror(errno) + ")");
+            throw std::runtime_error(socket_.string() + ": write failed (" + std::strerror(errno) +
+                                     ")");
         }
     }
 }

@@ -43,8 +43,7 @@ void ControlServer::claim(const std::filesystem::path& path) {
     const int probe = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
     const bool answers = probe >= 0 && ::connect(probe, address(), sizeof addr_) == 0;
     if (probe >= 0) ::close(probe);
-    if (answers)
-        throw InputError(path.string() + ": another lipsyncd answers on this socket");
+    if (answers) throw InputError(path.string() + ": another lipsyncd answers on this socket");
     ::unlink(path.c_str());  // stale
 }
 

@@ -7,7 +7,6 @@
 
 #include <chrono>
 #include <functional>
-
 #include <lipsyncd/daemon.hpp>
 #include <nlohmann/json.hpp>
 

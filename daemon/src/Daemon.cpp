@@ -68,9 +68,8 @@ void Daemon::Impl::tick() {
         }
     const auto& config = setup->config;
     // The mouth leads the sound by the puppet's lead time; the user's offset moves it later.
-    const auto clipFrame =
-        player.tick(*setup->audio, setup->puppet->leadSeconds - config.syncOffsetSeconds,
-                    config.outputRateHz);
+    const auto clipFrame = player.tick(
+        *setup->audio, setup->puppet->leadSeconds - config.syncOffsetSeconds, config.outputRateHz);
     if (live) {  // live input has the mouth while it is on
         const auto liveFrame = live->tick();
         liveFrame.empty() ? driver.tick(t) : driver.update(t, liveFrame);

@@ -12,12 +12,12 @@ double seconds(const TomlTable& t, const std::string& key, double fallback, doub
         t.fail(key, "must be within " + std::to_string(lo) + " .. " + std::to_string(hi) + " s");
     return v;
 }
-std::size_t count(const TomlTable& t, const std::string& key, std::size_t fallback,
-                  std::size_t lo, std::size_t hi) {
+std::size_t count(const TomlTable& t, const std::string& key, std::size_t fallback, std::size_t lo,
+                  std::size_t hi) {
     const double v = t.optNumber(key).value_or(static_cast<double>(fallback));
     if (!(v >= static_cast<double>(lo) && v <= static_cast<double>(hi) && v == std::floor(v)))
-        t.fail(key, "must be a whole number within " + std::to_string(lo) + " .. " +
-                        std::to_string(hi));
+        t.fail(key,
+               "must be a whole number within " + std::to_string(lo) + " .. " + std::to_string(hi));
     return static_cast<std::size_t>(v);
 }
 }  // namespace

@@ -29,11 +29,11 @@ json Daemon::Impl::statusReply() const {
     // the mouth has moved: the front end's bound, a tick, and the servo's lag.
     const double lead = setup->puppet->leadSeconds;
     const double tickSeconds = 0.01;
-    json latency = {{"audio_delay", player.clock().delay},
-                    {"lead", lead},
-                    {"sync_offset", config.syncOffsetSeconds},
-                    {"end_to_end", live ? live->frontEndLatency() + tickSeconds + lead
-                                        : player.clock().delay}};
+    json latency = {
+        {"audio_delay", player.clock().delay},
+        {"lead", lead},
+        {"sync_offset", config.syncOffsetSeconds},
+        {"end_to_end", live ? live->frontEndLatency() + tickSeconds + lead : player.clock().delay}};
     return {{"ok", true},
             {"playing", clip ? json(clip->name) : json(nullptr)},
             {"position", player.clock().heard},

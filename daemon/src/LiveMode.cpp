@@ -17,7 +17,7 @@ std::span<const float> LiveMode::tick() {
     if (frames_.frames() == 0) return {};
     const auto last = frames_.frame(frames_.frames() - 1);
     newest_.assign(last.begin(), last.end());  // no allocation after the first
-    frames_.times.clear();  // keep memory flat: only the newest frame matters
+    frames_.times.clear();                     // keep memory flat: only the newest frame matters
     frames_.values.clear();
     return newest_;
 }

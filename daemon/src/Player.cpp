@@ -23,7 +23,8 @@ void Player::write(AudioSink& audio) {
     const auto& s = clip_->samples;
     while (written_ < s.size()) {
         const auto n = std::min(block_.size(), s.size() - written_);
-        for (std::size_t i = 0; i < n; ++i) block_[i] = static_cast<float>(s[written_ + i]) / 32768.0f;
+        for (std::size_t i = 0; i < n; ++i)
+            block_[i] = static_cast<float>(s[written_ + i]) / 32768.0f;
         const auto taken = audio.write(std::span<const float>(block_).first(n));
         written_ += taken;
         if (taken < n) return;

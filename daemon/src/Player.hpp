@@ -31,7 +31,7 @@ class Player {
     std::optional<Clip> take();  // the clip (finished, or dropped), leaving nothing playing
 
     const Clip* clip() const { return clip_ ? &*clip_ : nullptr; }
-    const AudioClock& clock() const { return clock_; }  // as of the last tick
+    const AudioClock& clock() const { return clock_; }       // as of the last tick
     std::span<const float> frame() const { return frame_; }  // the frame last shown
 
   private:

@@ -72,8 +72,8 @@ void Daemon::Impl::reload() {
     sd_notify(0, "RELOADING=1");
     status("reloading " + configFile.string());
     try {
-        auto fresh = std::make_unique<Setup>(DaemonConfig::load(configFile), setup.get(),
-                                             logWarning);
+        auto fresh =
+            std::make_unique<Setup>(DaemonConfig::load(configFile), setup.get(), logWarning);
         if (setup->driver) restNow();  // a new puppet: the old one rests first
         if (fresh->clips->poseNames() != setup->clips->poseNames()) {
             logWarning("reload: the pose set changed; dropping what played and was queued");
@@ -86,7 +86,8 @@ void Daemon::Impl::reload() {
         queue.setCapacity(fresh->config.maxQueue);
         control->setMaxClients(fresh->config.maxClients);
         setup = std::move(fresh);
-        status(std::string("reloaded; ") + (player.clip() ? "playing " + player.clip()->name : "idle"));
+        status(std::string("reloaded; ") +
+               (player.clip() ? "playing " + player.clip()->name : "idle"));
     } catch (const std::exception& e) {
         logError("reload failed, keeping the running configuration: " + std::string(e.what()));
     }

@@ -24,7 +24,8 @@ struct Setup {
 
     // `previous`: the running setup, whose unchanged parts move into this one (it is left
     // without them: the caller drops it).
-    Setup(DaemonConfig config, Setup* previous, const std::function<void(const std::string&)>& warn);
+    Setup(DaemonConfig config, Setup* previous,
+          const std::function<void(const std::string&)>& warn);
     // Whether the mouth can go on into `next` without a stop: the same puppet, poses, sinks.
     bool keepsDriverFor(const Setup& next) const;
 

@@ -75,11 +75,11 @@ void checkActuatorBounds(const TomlTable& t, const ActuatorConfig& a) {
     for (const auto& [pose, gain] : a.gains)
         if (!(std::abs(gain) <= kLimit))
             t.fail("gains", "gain for '" + pose + "' must be a finite number within -1e6 .. 1e6");
-    const bool plain = !a.name.empty() && a.name.size() <= 64 &&
-                       std::all_of(a.name.begin(), a.name.end(), [](char c) {
-                           return std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
-                                  c == '-' || c == '.';
-                       });
+    const bool plain =
+        !a.name.empty() && a.name.size() <= 64 &&
+        std::all_of(a.name.begin(), a.name.end(), [](char c) {
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+        });
     if (!plain) t.fail("name", "must be 1 to 64 letters, digits, '_', '-' or '.'");
 }
 

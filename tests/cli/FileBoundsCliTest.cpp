@@ -28,8 +28,8 @@ TEST(FileBounds, AnimateRefusesASegmentEndingFarInTheFuture) {
     const auto dir = scratchDir("bounds_animate");
     for (const std::string end : {"1e7", "1e300"}) {
         const auto schedule = write(dir / "far.tsv", "0 0.1 sil\n0.1 " + end + " aa\n");
-        const auto r = runBounded({"animate", "--schedule", schedule.string(), "--weights",
-                                   (dir / "w.csv").string()});
+        const auto r = runBounded(
+            {"animate", "--schedule", schedule.string(), "--weights", (dir / "w.csv").string()});
         EXPECT_EQ(r.exitCode, 1) << end << ": " << r.err;
         EXPECT_NE(r.err.find("far.tsv:2"), std::string::npos) << r.err;
     }
@@ -38,8 +38,8 @@ TEST(FileBounds, AnimateRefusesASegmentEndingFarInTheFuture) {
 TEST(FileBounds, DriveRefusesAFarFutureRowInsteadOfLooping) {
     const auto dir = scratchDir("bounds_drive");
     const auto weights = write(dir / "far.csv", "time,open\n0,0.5\n1e300,0.5\n");
-    const auto r = runBounded({"drive", "--weights", weights.string(), "--puppet", "terminal",
-                               "--no-hardware"});
+    const auto r = runBounded(
+        {"drive", "--weights", weights.string(), "--puppet", "terminal", "--no-hardware"});
     EXPECT_EQ(r.exitCode, 1) << r.err;
     EXPECT_NE(r.err.find("far.csv:3"), std::string::npos) << r.err;
 }
@@ -64,8 +64,10 @@ std::string puppetWith(const std::string& line, const std::string& name = "jaw")
 TEST(FileBounds, PuppetFilesRefuseNonFiniteAndHugeNumbers) {
     const auto dir = scratchDir("bounds_puppet");
     const std::vector<std::pair<std::string, std::string>> cases = {
-        {"gains = { open = nan }", "gains"}, {"trim = nan", "trim"},
-        {"neutral = inf", "neutral"},        {"max = inf", "max"},
+        {"gains = { open = nan }", "gains"},
+        {"trim = nan", "trim"},
+        {"neutral = inf", "neutral"},
+        {"max = inf", "max"},
         {"min = -1e308", "min"},
     };
     for (const auto& [line, key] : cases) {

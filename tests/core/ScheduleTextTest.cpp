@@ -90,7 +90,6 @@ TEST(ScheduleText, UnknownPhonemesWarnOrFail) {
     EXPECT_NE(errorOf("0 0.1 zork\n", strict).find("'zork'"), std::string::npos);
 }
 
-
 TEST(ScheduleText, TimesBeyondADayAreRefusedWithTheLine) {
     EXPECT_NE(errorOf("0 0.1 sil\n0.1 1e7 aa\n").find("test.tsv:2:"), std::string::npos);
     EXPECT_NE(errorOf("0 1e300 aa\n").find("86400"), std::string::npos);

@@ -42,7 +42,8 @@ TEST(ClipPreparation, ClipsAndTextBeyondTheConfiguredLimitsAreRefused) {
     // Speech longer than the clip limit fails on the worker, said to subscribers; never plays.
     Client watcher(d.socket());
     ASSERT_TRUE(watcher.request({{"cmd", "subscribe"}})["ok"]);
-    ASSERT_TRUE(c.request({{"cmd", "say"}, {"text", "This takes longer than half a second."}})["ok"]);
+    ASSERT_TRUE(
+        c.request({{"cmd", "say"}, {"text", "This takes longer than half a second."}})["ok"]);
     bool failed = false;
     for (int i = 0; i < 200 && !failed; ++i) {
         const auto line = json::parse(watcher.readLine(), nullptr, false);
@@ -106,7 +107,8 @@ TEST(ClipPreparation, ReloadKeepsWhatPlaysAndWhatWaitsAndAppendsTheRecord) {
     d.start();
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
-    ASSERT_TRUE(c.request({{"cmd", "say"}, {"text", "Hello, this is the first of two lines."}})["ok"]);
+    ASSERT_TRUE(
+        c.request({{"cmd", "say"}, {"text", "Hello, this is the first of two lines."}})["ok"]);
     ASSERT_TRUE(c.request({{"cmd", "say"}, {"text", "And this is the second."}})["ok"]);
     std::this_thread::sleep_for(800ms);
     const auto before = c.request({{"cmd", "status"}});

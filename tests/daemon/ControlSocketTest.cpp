@@ -99,7 +99,8 @@ TEST(ControlSocket, RunningOutOfFileDescriptorsDegradesAndNeverSpins) {
     crowd.clear();
     Client later(d.socket());
     ASSERT_TRUE(later.connected());
-    EXPECT_TRUE(later.request({{"cmd", "status"}})["ok"]) << "no recovery once descriptors are free";
+    EXPECT_TRUE(later.request({{"cmd", "status"}})["ok"])
+        << "no recovery once descriptors are free";
     EXPECT_EQ(d.stop(), 0);
 }
 

@@ -11,10 +11,10 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
-#include <optional>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/daemon.hpp>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #include "../cli/RunLipsync.hpp"

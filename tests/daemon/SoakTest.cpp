@@ -70,15 +70,15 @@ TEST(Soak, HostileClientsDuringPlaybackNeitherStopNorStallTheShow) {
     for (int i = 0; i < 4; ++i) ASSERT_TRUE(c.request({{"cmd", "play"}, {"file", example}})["ok"]);
     std::atomic<bool> stop{false};
     std::vector<std::thread> vandals;
-    for (int i = 0; i < 3; ++i)
-        vandals.emplace_back([&] { vandalise(d.socket(), fifo, stop); });
+    for (int i = 0; i < 3; ++i) vandals.emplace_back([&] { vandalise(d.socket(), fifo, stop); });
     std::vector<std::unique_ptr<Client>> crowd;  // more than max_clients
     for (int i = 0; i < 10; ++i) crowd.push_back(std::make_unique<Client>(d.socket()));
     std::vector<double> answers;
     for (int i = 0; i < 70; ++i) {  // 7 s: the first 5.2 s clip plays through
         const auto t0 = std::chrono::steady_clock::now();
         const auto s = c.request({{"cmd", "status"}});
-        answers.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        answers.push_back(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         ASSERT_TRUE(s["ok"]) << s;
         if (i == 35) ::kill(d.pid, SIGHUP);
         std::this_thread::sleep_for(100ms);

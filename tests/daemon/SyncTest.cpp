@@ -109,7 +109,8 @@ TEST(Sync, StatusReportsTheEndToEndLatency) {
     d.start();
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
-    ASSERT_TRUE(c.request({{"cmd", "play"}, {"file", findDataFile("examples/hello.wav").string()}})["ok"]);
+    ASSERT_TRUE(
+        c.request({{"cmd", "play"}, {"file", findDataFile("examples/hello.wav").string()}})["ok"]);
     std::this_thread::sleep_for(600ms);
     const auto s = c.request({{"cmd", "status"}});
     ASSERT_TRUE(s.contains("latency")) << s;

@@ -140,7 +140,8 @@ struct ScheduleReadOptions {
 
 // Reads TSV / .lab text: `start end phoneme [confidence]` separated by tabs or spaces, '#'
 // comments and blank lines allowed. Checks times (finite, within 0 .. 86400 s, end > start,
-// sorted, no overlaps) and phonemes; errors name `sourceName` and the line. Warnings go to `warnings`.
+// sorted, no overlaps) and phonemes; errors name `sourceName` and the line. Warnings go to
+// `warnings`.
 PhonemeSchedule readSchedule(std::istream& in, const std::string& sourceName,
                              const ScheduleReadOptions& options = {},
                              std::vector<std::string>* warnings = nullptr);

@@ -107,7 +107,7 @@ class ControlClient {
     ControlClient& operator=(const ControlClient&) = delete;
 
     nlohmann::json request(const nlohmann::json& request);  // send, then the next reply
-    void sendRaw(std::string_view bytes);                    // any bytes (tests send bad ones)
+    void sendRaw(std::string_view bytes);                   // any bytes (tests send bad ones)
     std::string readLine();  // the next line; std::runtime_error on timeout or a closed socket
 
   private:
