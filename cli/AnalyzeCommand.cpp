@@ -58,7 +58,7 @@ void runAnalyze(const AnalyzeOptions& o) {
         });
     if (!o.frames.empty())
         withOutputStream(o.frames, [&](std::ostream& out) { writeFrames(out, result, set); });
-    if (!o.runtime.weights.empty()) o.runtime.writeWeights(o.runtime.animate(result.schedule));
+    if (!o.runtime.weights.empty()) o.runtime.writeWeights(o.runtime.animate(result.schedule, &result.levels));
 }
 }  // namespace
 

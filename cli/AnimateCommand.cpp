@@ -1,6 +1,8 @@
 // lipsync animate: a phoneme schedule to mouth-pose weights (the phone-bigram runtime), and
 // lipsync curves generate: the curve set from its rules.
 #include <iostream>
+#include <lipsyncd/dsp.hpp>
+#include <optional>
 
 #include "Commands.hpp"
 #include "Corpus.hpp"
@@ -13,6 +15,7 @@ struct AnimateOptions {
     std::string schedule;
     std::string labels = "auto";
     double delay = -1;  // < 0: offline
+    std::string audio;  // the speech the schedule belongs to: its loudness shapes the mouth
     RuntimeOptions runtime;
 };
 
@@ -21,9 +24,16 @@ void runAnimate(const AnimateOptions& o) {
     if (o.delay >= 0 && o.runtime.runtime != "bigram")
         throw CLI::ValidationError("--delay", "streaming is for --runtime bigram");
     if (o.delay < 0) {
-        o.runtime.writeWeights(o.runtime.animate(schedule));
+        std::optional<LevelTrack> levels;
+        if (!o.audio.empty()) {
+            const auto audio = dsp::readAudioFile(o.audio);
+            levels = dsp::measureLevels(audio.samples, audio.sampleRate);
+        }
+        o.runtime.writeWeights(o.runtime.animate(schedule, levels ? &*levels : nullptr));
         return;
     }
+    if (!o.audio.empty())
+        throw CLI::ValidationError("--audio", "loudness shaping is for offline runs (no --delay)");
     // Streaming, as the daemon runs it: segment by segment, with the given delay.
     const auto loaded = o.runtime.load();
     lipsync::StreamingRuntime stream(loaded.curves, loaded.poses, o.delay, o.runtime.config,
@@ -56,6 +66,9 @@ void addAnimateCommand(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--delay", o->delay,
                     "Run streaming with this delay in seconds (0: causal), as the daemon does");
+    cmd->add_option("--audio", o->audio,
+                    "The speech the schedule belongs to (WAV...): louder speech opens the mouth "
+                    "wider, as in analyze and say");
     o->runtime.addTo(*cmd, false);
     cmd->callback([o] { runAnimate(*o); });
 }

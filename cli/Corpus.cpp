@@ -2,14 +2,15 @@
 
 #include <algorithm>
 #include <iostream>
+#include <tuple>
 
 namespace lipsyncd::cli {
 
 namespace fs = std::filesystem;
 
-std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>* skipped) {
-    if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder");
-    std::vector<CorpusItem> items;
+namespace {
+void addPairs(const fs::path& dir, const std::string& speaker, std::vector<CorpusItem>& items,
+              std::vector<std::string>* skipped) {
     for (const auto& entry : fs::directory_iterator(dir)) {
         if (entry.path().extension() != ".wav") continue;
         auto lab = entry.path();
@@ -19,10 +20,22 @@ std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>
                 skipped->push_back(entry.path().string() + ": no " + lab.filename().string());
             continue;
         }
-        items.push_back({entry.path().stem().string(), entry.path(), lab});
+        items.push_back({speaker, entry.path().stem().string(), entry.path(), lab});
     }
-    std::sort(items.begin(), items.end(),
-              [](const auto& a, const auto& b) { return a.name < b.name; });
+}
+}  // namespace
+
+std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>* skipped) {
+    if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder");
+    std::vector<CorpusItem> items;
+    auto own = fs::weakly_canonical(fs::absolute(dir)).filename().string();
+    addPairs(dir, own.empty() ? "corpus" : own, items, skipped);
+    for (const auto& entry : fs::directory_iterator(dir))
+        if (entry.is_directory())
+            addPairs(entry.path(), entry.path().filename().string(), items, skipped);
+    std::sort(items.begin(), items.end(), [](const auto& a, const auto& b) {
+        return std::tie(a.speaker, a.name) < std::tie(b.speaker, b.name);
+    });
     if (items.empty()) throw InputError(dir.string() + ": no NAME.wav + NAME.lab pairs");
     return items;
 }

@@ -10,13 +10,16 @@
 namespace lipsyncd::cli {
 
 struct CorpusItem {
+    std::string speaker;  // the subfolder it lies in, or the corpus folder's own name
     std::string name;
     std::filesystem::path audio;
     std::filesystem::path labels;
 };
 
-// Every NAME.wav with a NAME.lab, sorted by name. Throws InputError for a missing folder or
-// one with no pairs; audio without labels is reported in `skipped`.
+// Every NAME.wav with a NAME.lab in DIR and in its subfolders one level down (DIR/SPEAKER/:
+// one folder per speaker, so figures can be given per speaker), sorted by speaker and name.
+// Throws InputError for a missing folder or one with no pairs; audio without labels is
+// reported in `skipped`.
 std::vector<CorpusItem> listCorpus(const std::filesystem::path& dir,
                                    std::vector<std::string>* skipped = nullptr);
 

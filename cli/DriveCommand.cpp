@@ -1,5 +1,6 @@
 // lipsync drive / check / devices: pose weights through a puppet's actuators; a puppet file
-// validated and explained; the GPIO chips and HID boards present.
+// validated and explained; the GPIO chips, HID boards, I2C buses, serial ports and PWM chips
+// present.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -80,6 +81,24 @@ void runDrive(const DriveOptions& o) {
 }
 }  // namespace
 
+// The servo boards' buses and ports, each with the puppet keys that name it.
+void listSection(const std::string& title, const std::vector<std::string>& found,
+                 const std::string& none) {
+    std::cout << title << '\n';
+    if (found.empty()) std::cout << "  none (" << none << ")\n";
+    for (const auto& f : found) std::cout << "  " << f << '\n';
+}
+
+void listServoBoards() {
+    listSection("I2C buses (PCA9685: backend = \"pca9685\", bus = N, address = 0x40):",
+                output::listI2cBuses(),
+                "no /dev/i2c-*: enable I2C and load i2c-dev, e.g. raspi-config");
+    listSection("Serial ports (Maestro: backend = \"maestro\", port = \"/dev/serial/by-id/...\"):",
+                output::listSerialPorts(), "no USB serial board plugged in");
+    listSection("PWM chips (backend = \"pwm\", chip = N, channel = M):", output::listPwmChips(),
+                "no /sys/class/pwm/pwmchip*: enable a PWM overlay, e.g. dtoverlay=pwm-2chan");
+}
+
 void addDriveCommands(CLI::App& app) {
     auto o = std::make_shared<DriveOptions>();
     auto* drive = app.add_subcommand("drive", "Play pose weights through a puppet's actuators");
@@ -110,7 +129,9 @@ void addDriveCommands(CLI::App& app) {
     });
 
     auto* devices =
-        app.add_subcommand("devices", "List the GPIO chips and USB HID devices present");
+        app.add_subcommand("devices",
+                           "List the GPIO chips, USB HID devices, I2C buses, serial ports and "
+                           "PWM chips present");
     devices->callback([] {
         const auto chips = output::listGpioChips();
         std::cout << "GPIO chips (name them in a puppet as chip = \"gpiochipN\", line = OFFSET):\n";
@@ -125,6 +146,7 @@ void addDriveCommands(CLI::App& app) {
             std::cout << "  none (no /dev/hidraw*, or no permission: see "
                          "systemd/99-lipsyncd-hidraw.rules)\n";
         for (const auto& h : hid) std::cout << "  " << h << '\n';
+        listServoBoards();
     });
 }
 

@@ -1,7 +1,9 @@
-// lipsync eval: how well `analyze` agrees with reference labels, over a corpus.
+// lipsync eval: how well `analyze` agrees with reference labels over a corpus, and how well a
+// puppet's jaw follows the speech, per file and per speaker (the worst speaker is the figure).
 #include <iomanip>
 #include <iostream>
 #include <lipsyncd/dsp.hpp>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -9,37 +11,139 @@
 #include "Corpus.hpp"
 #include "FrontEndOptions.hpp"
 #include "Output.hpp"
+#include "PuppetJaw.hpp"
+#include "RuntimeOptions.hpp"
 
 namespace lipsyncd::cli {
 
 namespace {
+constexpr double kFrameRate = 100;  // jaw frames per second, as the schedule score's step
+
 struct EvalOptions {
     std::string corpus;
     std::string labels = "auto";
     std::string json;
+    std::string puppet = "jaw-servo", jawActuator;
     double minAccuracy = 0, minGroupAccuracy = 0;
-    bool perFile = true;
+    double minJawR = -1, minExactJawR = -1, minExactClosures = 0;
+    bool perFile = true, jaw = true;
     FrontEndOptions frontEnd;
+    RuntimeOptions runtime;
 };
 
-struct FileScore {
-    std::string name;
-    dsp::ScheduleScore score;
-};
-
-void printReport(std::ostream& out, const std::vector<FileScore>& files,
-                 const dsp::ScheduleScore& total, const PhonemeSet& set, bool perFile) {
-    out << std::fixed << std::setprecision(1);
-    if (perFile) {
-        out << std::left << std::setw(32) << "file" << std::right << std::setw(8) << "frames"
-            << std::setw(10) << "accuracy" << std::setw(8) << "group" << '\n';
-        for (const auto& f : files)
-            out << std::left << std::setw(32) << f.name << std::right << std::setw(8)
-                << f.score.frames << std::setw(9) << 100 * f.score.accuracy() << '%' << std::setw(7)
-                << 100 * f.score.groupAccuracy() << "%\n";
-        out << '\n';
+// The three ways a jaw can be driven, each scored against the same reference.
+struct JawScores {
+    lipsync::JawScore audio;     // audio → analyze → runtime → puppet
+    lipsync::JawScore labels;    // reference phonemes → runtime → puppet
+    lipsync::JawScore envelope;  // audio → loudness envelope follower → puppet
+    void add(const JawScores& o) {
+        audio.add(o.audio), labels.add(o.labels), envelope.add(o.envelope);
     }
-    out << "per class (reference): frames, recall, most often taken for\n";
+};
+
+struct Score {
+    dsp::ScheduleScore schedule;
+    JawScores jaw;
+    void add(const Score& o) { schedule.add(o.schedule), jaw.add(o.jaw); }
+};
+
+struct Row {
+    std::string speaker, name;
+    Score score;
+};
+
+// Everything loaded once for the whole corpus.
+struct Evaluator {
+    const EvalOptions& o;
+    const PhonemeSet& set = PhonemeSet::common();
+    dsp::TemplateSet templates = o.frontEnd.loadTemplates();
+    RuntimeOptions::Loaded runtime = o.runtime.load();
+    std::optional<PuppetJaw> puppet;
+
+    explicit Evaluator(const EvalOptions& options) : o(options) {
+        if (o.jaw) puppet.emplace(output::Puppet::named(o.puppet), o.jawActuator);
+    }
+
+    // The pose track an envelope follower makes: its value on the jaw pose, nothing else.
+    PoseTrack envelopeTrack(const LevelTrack& levels) const {
+        const auto jawPose = runtime.poses.find("jaw");
+        if (!jawPose) throw InputError("pose set '" + runtime.poses.name() + "' has no 'jaw' pose");
+        PoseTrack track;
+        track.poses = runtime.poses.names();
+        std::vector<float> row(track.poses.size(), 0.0f);
+        const auto envelope = dsp::followEnvelope(levels);
+        for (std::size_t f = 0; f < envelope.size(); ++f) {
+            row[*jawPose] = envelope[f];
+            track.append(levels.start + static_cast<double>(f) / levels.rate, row);
+        }
+        return track;
+    }
+
+    JawScores scoreJaws(const CorpusItem& item, const PhonemeSchedule& reference,
+                        const dsp::AnalysisResult& analysis) const {
+        const auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
+        const auto levels = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
+        const auto frames = static_cast<std::size_t>(reference.back().end * kFrameRate) + 1;
+        const auto truth = lipsync::jawReference(reference, set, kFrameRate, frames);
+        const auto score = [&](const PoseTrack& track) {
+            return lipsync::scoreJaw(puppet->record(track, kFrameRate, frames), truth, reference,
+                                     set, kFrameRate);
+        };
+        return {score(o.runtime.animate(analysis.schedule, runtime, &levels)),
+                score(o.runtime.animate(reference, runtime, &levels)),
+                score(envelopeTrack(levels))};
+    }
+
+    Score scoreFile(const CorpusItem& item) const {
+        const auto reference = readLabels(item.labels, o.labels);
+        const auto analysis = dsp::analyzeFile(item.audio, templates, set, o.frontEnd.config(),
+                                               o.frontEnd.decode(), std::nullopt);
+        Score s;
+        s.schedule = dsp::scoreSchedule(analysis.schedule, reference, set);
+        if (puppet && !reference.empty()) s.jaw = scoreJaws(item, reference, analysis);
+        return s;
+    }
+};
+
+std::string pct(double x) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(1) << 100 * x << '%';
+    return s.str();
+}
+std::string fixed2(double x) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(2) << x;
+    return s.str();
+}
+
+void printHeader(std::ostream& out, const std::string& first, bool jaw) {
+    out << std::left << std::setw(30) << first << std::right << std::setw(7) << "frames"
+        << std::setw(8) << "acc" << std::setw(8) << "group";
+    if (jaw)
+        out << "  | jaw r: audio labels envelope | closures: audio labels envelope"
+               " | false closed: audio labels envelope";
+    out << '\n';
+}
+
+void printRow(std::ostream& out, const std::string& first, const Score& s, bool jaw) {
+    out << std::left << std::setw(30) << first << std::right << std::setw(7) << s.schedule.frames
+        << std::setw(8) << pct(s.schedule.accuracy()) << std::setw(8)
+        << pct(s.schedule.groupAccuracy());
+    if (jaw) {
+        const auto& j = s.jaw;
+        out << "  |      " << std::setw(6) << fixed2(j.audio.r()) << std::setw(7)
+            << fixed2(j.labels.r()) << std::setw(9) << fixed2(j.envelope.r()) << " |"
+            << std::setw(16) << pct(j.audio.closureRate()) << std::setw(7)
+            << pct(j.labels.closureRate()) << std::setw(9) << pct(j.envelope.closureRate()) << " |"
+            << std::setw(20) << pct(j.audio.falseClosureRate()) << std::setw(7)
+            << pct(j.labels.falseClosureRate()) << std::setw(9)
+            << pct(j.envelope.falseClosureRate());
+    }
+    out << '\n';
+}
+
+void printConfusion(std::ostream& out, const dsp::ScheduleScore& total, const PhonemeSet& set) {
+    out << "per class (reference): frames, recall, most often taken for\n" << std::fixed;
     for (std::size_t r = 0; r < set.size(); ++r) {
         std::size_t n = 0, worst = r;
         for (std::size_t h = 0; h < set.size(); ++h) {
@@ -49,61 +153,139 @@ void printReport(std::ostream& out, const std::vector<FileScore>& files,
         }
         if (n == 0) continue;
         out << "  " << std::left << std::setw(5) << set[r].name << std::right << std::setw(7) << n
-            << std::setw(8) << 100.0 * total.confusion[r][r] / n << '%';
+            << std::setw(8) << std::setprecision(1) << 100.0 * total.confusion[r][r] / n << '%';
         if (worst != r)
             out << "   " << set[worst].name << " (" << 100.0 * total.confusion[r][worst] / n
                 << "%)";
         out << '\n';
     }
-    out << "\nfiles " << files.size() << ", frames " << total.frames << ": accuracy "
-        << 100 * total.accuracy() << "% (common set), " << 100 * total.groupAccuracy()
-        << "% (visual groups)\n";
 }
 
-nlohmann::json toJson(const std::vector<FileScore>& files, const dsp::ScheduleScore& total,
-                      const PhonemeSet& set) {
-    nlohmann::json j;
-    j["frames"] = total.frames;
-    j["accuracy"] = total.accuracy();
-    j["group_accuracy"] = total.groupAccuracy();
-    for (const auto& f : files)
-        j["files"].push_back({{"name", f.name},
-                              {"frames", f.score.frames},
-                              {"accuracy", f.score.accuracy()},
-                              {"group_accuracy", f.score.groupAccuracy()}});
-    for (std::size_t r = 0; r < set.size(); ++r)
-        for (std::size_t h = 0; h < set.size(); ++h)
-            if (total.confusion[r][h] > 0)
-                j["confusion"][set[r].name][set[h].name] = total.confusion[r][h];
+nlohmann::json jawJson(const lipsync::JawScore& j) {
+    return {{"r", j.r()},
+            {"closures", j.closures},
+            {"closures_caught", j.closureRate()},
+            {"open_frames", j.openFrames},
+            {"false_closures", j.falseClosureRate()}};
+}
+
+nlohmann::json scoreJson(const Score& s, bool jaw) {
+    nlohmann::json j{{"frames", s.schedule.frames},
+                     {"accuracy", s.schedule.accuracy()},
+                     {"group_accuracy", s.schedule.groupAccuracy()}};
+    if (jaw)
+        j["jaw"] = {{"audio", jawJson(s.jaw.audio)},
+                    {"labels", jawJson(s.jaw.labels)},
+                    {"envelope", jawJson(s.jaw.envelope)}};
     return j;
 }
 
+struct Report {
+    std::vector<Row> files;
+    std::map<std::string, Score> speakers;
+    Score total;
+};
+
+nlohmann::json toJson(const Report& report, const PhonemeSet& set, const EvalOptions& o) {
+    auto j = scoreJson(report.total, o.jaw);
+    if (o.jaw) j["puppet"] = o.puppet;
+    for (const auto& f : report.files) {
+        auto row = scoreJson(f.score, o.jaw);
+        row["name"] = f.name;
+        row["speaker"] = f.speaker;
+        j["files"].push_back(row);
+    }
+    for (const auto& [name, s] : report.speakers) j["speakers"][name] = scoreJson(s, o.jaw);
+    for (std::size_t r = 0; r < set.size(); ++r)
+        for (std::size_t h = 0; h < set.size(); ++h)
+            if (report.total.schedule.confusion[r][h] > 0)
+                j["confusion"][set[r].name][set[h].name] = report.total.schedule.confusion[r][h];
+    return j;
+}
+
+// The speaker with the lowest value of `figure`.
+template <class F>
+std::pair<std::string, double> worst(const Report& report, F figure) {
+    std::pair<std::string, double> w{"", 2.0};
+    for (const auto& [name, s] : report.speakers)
+        if (figure(s) < w.second) w = {name, figure(s)};
+    return w;
+}
+
+void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
+                 const EvalOptions& o) {
+    if (o.perFile) {
+        printHeader(out, "file", o.jaw);
+        for (const auto& f : report.files) printRow(out, f.speaker + "/" + f.name, f.score, o.jaw);
+        out << '\n';
+    }
+    printConfusion(out, report.total.schedule, set);
+    out << '\n';
+    printHeader(out, "speaker", o.jaw);
+    for (const auto& [name, s] : report.speakers) printRow(out, name, s, o.jaw);
+    printRow(out, "all", report.total, o.jaw);
+    const auto group = worst(report, [](const Score& s) { return s.schedule.groupAccuracy(); });
+    out << "\nfiles " << report.files.size() << ", speakers " << report.speakers.size()
+        << ", frames " << report.total.schedule.frames << ": accuracy "
+        << pct(report.total.schedule.accuracy()) << " (common set), "
+        << pct(report.total.schedule.groupAccuracy()) << " (visual groups); worst speaker "
+        << group.first << ' ' << pct(group.second) << '\n';
+    if (o.jaw) {
+        const auto audio = worst(report, [](const Score& s) { return s.jaw.audio.r(); });
+        const auto labels = worst(report, [](const Score& s) { return s.jaw.labels.r(); });
+        out << "jaw through '" << o.puppet << "': r " << fixed2(report.total.jaw.audio.r())
+            << " from audio (worst speaker " << audio.first << ' ' << fixed2(audio.second) << "), "
+            << fixed2(report.total.jaw.labels.r()) << " from the labels (worst " << labels.first
+            << ' ' << fixed2(labels.second) << "), envelope follower "
+            << fixed2(report.total.jaw.envelope.r()) << '\n';
+    }
+}
+
+void checkFloors(const Report& report, const EvalOptions& o) {
+    std::ostringstream why;
+    const auto& t = report.total.schedule;
+    if (t.accuracy() < o.minAccuracy || t.groupAccuracy() < o.minGroupAccuracy)
+        why << "accuracy " << pct(t.accuracy()) << " / group " << pct(t.groupAccuracy())
+            << " is below the floor " << pct(o.minAccuracy) << " / " << pct(o.minGroupAccuracy)
+            << ". ";
+    if (o.jaw) {
+        const auto audio = worst(report, [](const Score& s) { return s.jaw.audio.r(); });
+        const auto exact = worst(report, [](const Score& s) { return s.jaw.labels.r(); });
+        const auto closures =
+            worst(report, [](const Score& s) { return s.jaw.labels.closureRate(); });
+        if (audio.second < o.minJawR)
+            why << "jaw r from audio " << fixed2(audio.second) << " (" << audio.first
+                << ") is below the floor " << fixed2(o.minJawR) << ". ";
+        if (exact.second < o.minExactJawR)
+            why << "jaw r from the labels " << fixed2(exact.second) << " (" << exact.first
+                << ") is below the floor " << fixed2(o.minExactJawR) << ". ";
+        if (closures.second < o.minExactClosures)
+            why << "closures caught from the labels " << pct(closures.second) << " ("
+                << closures.first << ") are below the floor " << pct(o.minExactClosures) << ". ";
+    }
+    if (!why.str().empty()) throw std::runtime_error(why.str());
+}
+
 void runEval(const EvalOptions& o) {
-    const auto& set = PhonemeSet::common();
-    const auto templates = o.frontEnd.loadTemplates();
+    const Evaluator evaluator(o);
     std::vector<std::string> skipped;
     const auto items = listCorpus(o.corpus, &skipped);
     for (const auto& s : skipped) std::cerr << "lipsync eval: skipped " << s << '\n';
-    std::vector<FileScore> files;
-    dsp::ScheduleScore total;
-    for (const auto& item : items) {
-        const auto reference = readLabels(item.labels, o.labels);
-        const auto result = dsp::analyzeFile(item.audio, templates, set, o.frontEnd.config(),
-                                             o.frontEnd.decode(), std::nullopt);
-        files.push_back({item.name, dsp::scoreSchedule(result.schedule, reference, set)});
-        total.add(files.back().score);
+    Report report;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        if (items.size() >= 20 && i % 20 == 0)
+            std::cerr << "lipsync eval: " << i << " of " << items.size() << " files\n";
+        const auto& item = items[i];
+        report.files.push_back({item.speaker, item.name, evaluator.scoreFile(item)});
+        report.speakers[item.speaker].add(report.files.back().score);
+        report.total.add(report.files.back().score);
     }
-    printReport(std::cout, files, total, set, o.perFile);
+    printReport(std::cout, report, evaluator.set, o);
     if (!o.json.empty())
-        withOutputStream(
-            o.json, [&](std::ostream& out) { out << toJson(files, total, set).dump(1) << '\n'; });
-    if (total.accuracy() < o.minAccuracy || total.groupAccuracy() < o.minGroupAccuracy) {
-        std::ostringstream msg;
-        msg << std::fixed << std::setprecision(1) << "accuracy " << 100 * total.accuracy()
-            << "% / group " << 100 * total.groupAccuracy() << "% is below the floor "
-            << 100 * o.minAccuracy << "% / " << 100 * o.minGroupAccuracy << '%';
-        throw std::runtime_error(msg.str());
-    }
+        withOutputStream(o.json, [&](std::ostream& out) {
+            out << toJson(report, evaluator.set, o).dump(1) << '\n';
+        });
+    checkFloors(report, o);
 }
 }  // namespace
 
@@ -111,20 +293,46 @@ void addEvalCommand(CLI::App& app) {
     auto o = std::make_shared<EvalOptions>();
     auto* cmd = app.add_subcommand(
         "eval",
-        "Score 'analyze' against reference labels on every NAME.wav + NAME.lab in a folder");
-    cmd->add_option("--corpus", o->corpus, "Folder of NAME.wav + NAME.lab")->required();
+        "Score 'analyze' and a puppet's jaw against reference labels, per file and per speaker "
+        "(NAME.wav + NAME.lab in a folder, or in one subfolder per speaker)");
+    cmd->footer(
+        "The jaw is scored three ways, each driven through the puppet's actuators: from the "
+        "audio (analyze → runtime), from the reference labels (exact phonemes → runtime), and by "
+        "a loudness envelope follower (the built-in baseline). The reference is each labelled "
+        "phoneme's jaw height (config/phonemes/common.toml) smoothed over 40 ms. r: Pearson "
+        "correlation; closures: bilabial closures inside speech where the jaw closed (below "
+        "15 % of its travel); false closed: frames where the reference is clearly open (above "
+        "0.5) but the jaw is closed.");
+    cmd->add_option("--corpus", o->corpus, "Folder of NAME.wav + NAME.lab (or SPEAKER/ folders)")
+        ->required();
     cmd->add_option("--labels", o->labels,
                     "Label alphabet: auto, common, arpabet, or a map name/file")
         ->capture_default_str();
     cmd->add_option("--json", o->json, "Also write the figures as JSON ('-' for stdout)");
+    cmd->add_option("--puppet", o->puppet, "Puppet whose jaw is scored (name or file)")
+        ->capture_default_str();
+    cmd->add_option("--jaw-actuator", o->jawActuator,
+                    "The puppet's jaw actuator (default: the one named 'jaw', else the first)");
+    cmd->add_flag("!--no-jaw", o->jaw, "Score the schedule only, not the jaw");
     cmd->add_option("--min-accuracy", o->minAccuracy,
                     "Exit 1 when frame accuracy (0..1) falls below this")
         ->check(CLI::Range(0.0, 1.0));
     cmd->add_option("--min-group-accuracy", o->minGroupAccuracy,
                     "Exit 1 when visual-group accuracy (0..1) falls below this")
         ->check(CLI::Range(0.0, 1.0));
+    cmd->add_option("--min-jaw-r", o->minJawR,
+                    "Exit 1 when the worst speaker's jaw r from audio falls below this")
+        ->check(CLI::Range(-1.0, 1.0));
+    cmd->add_option("--min-exact-jaw-r", o->minExactJawR,
+                    "Exit 1 when the worst speaker's jaw r from the labels falls below this")
+        ->check(CLI::Range(-1.0, 1.0));
+    cmd->add_option("--min-exact-closures", o->minExactClosures,
+                    "Exit 1 when the worst speaker's closures caught from the labels (0..1) fall "
+                    "below this")
+        ->check(CLI::Range(0.0, 1.0));
     cmd->add_flag("!--no-per-file", o->perFile, "Leave out the per-file table");
     o->frontEnd.addTo(*cmd);
+    o->runtime.addTo(*cmd, false);
     cmd->callback([o] { runEval(*o); });
 }
 

@@ -19,6 +19,7 @@ struct RuntimeOptions {
     std::string runtime = "bigram";
     std::string phonemes = "common";
     lipsync::RuntimeConfig config;
+    bool loudness = true;  // shape poses by the speech level where the audio is known
 
     // `withWeights`: add --weights (commands whose main output is something else).
     void addTo(CLI::App& cmd, bool withWeights) {
@@ -46,6 +47,10 @@ struct RuntimeOptions {
         cmd.add_flag("!--no-smoothing", config.smoothing, "Skip valley smoothing (for comparison)");
         cmd.add_flag("!--no-constraints", config.constraints, "Skip pose-pair constraints");
         cmd.add_flag("!--no-speed-limits", config.speedLimits, "Skip speed limits");
+        cmd.add_flag("!--no-rest", config.restInPauses,
+                     "Do not force the mouth to rest in pauses and after speech");
+        cmd.add_flag("!--no-loudness", loudness,
+                     "Do not let louder speech open the mouth wider (poses' loudness_gain)");
     }
 
     struct Loaded {
@@ -62,12 +67,20 @@ struct RuntimeOptions {
         return {std::move(poseSet), std::move(set)};
     }
 
-    PoseTrack animate(const PhonemeSchedule& schedule) const {
-        const auto loaded = load();
-        if (runtime == "filter")
-            return lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config,
-                                          phonemeSet());
-        return lipsync::animate(schedule, loaded.curves, loaded.poses, config, phonemeSet());
+    // The runtime over a schedule; with `levels` (the speech's frame levels) and loudness on,
+    // louder speech opens wider within what each phoneme allows.
+    PoseTrack animate(const PhonemeSchedule& schedule, const Loaded& loaded,
+                      const LevelTrack* levels = nullptr) const {
+        auto track =
+            runtime == "filter"
+                ? lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config,
+                                         phonemeSet())
+                : lipsync::animate(schedule, loaded.curves, loaded.poses, config, phonemeSet());
+        if (levels && loudness) lipsync::shapeByLoudness(loaded.poses, *levels, track);
+        return track;
+    }
+    PoseTrack animate(const PhonemeSchedule& schedule, const LevelTrack* levels = nullptr) const {
+        return animate(schedule, load(), levels);
     }
 
     void writeWeights(const PoseTrack& track) const {

@@ -39,7 +39,11 @@ void runSay(const SayOptions& o) {
     if (!o.runtime.weights.empty()) {
         if (o.raw)
             throw CLI::ValidationError("--weights", "needs the common set: drop --raw-phonemes");
-        o.runtime.writeWeights(o.runtime.animate(schedule));
+        // The exact schedule, opened as wide as the synthesised speech is loud.
+        std::vector<float> samples(speech.samples.begin(), speech.samples.end());
+        for (auto& x : samples) x /= 32768.0f;
+        const auto levels = dsp::measureLevels(samples, speech.sampleRate);
+        o.runtime.writeWeights(o.runtime.animate(schedule, &levels));
     }
 }
 }  // namespace

@@ -16,8 +16,8 @@ echo "== 1. lipsync analyze $example  (audio -> phoneme schedule -> pose weights
 echo "   first segments of out/hello.tsv (start, end, phoneme, confidence):"
 head -n 6 out/hello.tsv | sed 's/^/     /'
 
-echo "== 2. lipsync eval --corpus config/examples  (schedule vs espeak-ng's own timings)"
-"$lipsync" eval --corpus config/examples | tail -n 1
+echo "== 2. lipsync eval --corpus config/examples  (schedule and the jaw-servo puppet's jaw vs espeak-ng's own timings)"
+"$lipsync" eval --corpus config/examples | tail -n 2
 
 echo "== 3. lipsync plot  (pose curves with the phonemes under them)"
 "$lipsync" plot --weights out/hello.csv --schedule out/hello.tsv -o out/hello.svg

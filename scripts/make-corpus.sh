@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Generates a labelled speech corpus with espeak-ng: for every sentence and voice, NAME.wav and
-# NAME.lab (common-set labels from espeak-ng's own phoneme events, so they are exact).
+# Generates a labelled speech corpus with espeak-ng: for every sentence and voice,
+# VOICE/sNN.wav and VOICE/sNN.lab (common-set labels from espeak-ng's own phoneme events, so they
+# are exact; sNN is the NNth sentence of the list). One folder per voice: `lipsync eval` gives
+# figures per speaker, and the worst one is the figure that counts.
 #
 #   scripts/make-corpus.sh train OUT_DIR   # the training corpus (templates are trained on it)
 #   scripts/make-corpus.sh dev OUT_DIR     # the development corpus (held-out sentences AND voices)
@@ -35,10 +37,12 @@ while IFS= read -r line; do
   n=$((n + 1))
   for v in "${voices[@]}"; do
     IFS=: read -r voice rate pitch <<<"$v"
-    name="$(printf 's%02d_%s' "$n" "${voice//+/_}")"
-    [ -s "$out/$name.lab" ] && continue
+    dir="$out/${voice//+/_}"
+    name="$(printf 's%02d' "$n")"
+    [ -s "$dir/$name.lab" ] && continue
+    mkdir -p "$dir"
     "$lipsync" say "$line" --voice "$voice" --rate "$rate" --pitch "$pitch" \
-      --wav "$out/$name.wav" --schedule "$out/$name.lab" 2>>"$out/warnings.txt"
+      --wav "$dir/$name.wav" --schedule "$dir/$name.lab" 2>>"$out/warnings.txt"
   done
 done <"$sentences"
-echo "make-corpus.sh: $kind corpus in $out ($(ls "$out"/*.wav | wc -l) files)" >&2
+echo "make-corpus.sh: $kind corpus in $out ($(ls "$out"/*/*.wav | wc -l) files)" >&2

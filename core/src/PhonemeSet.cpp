@@ -33,6 +33,10 @@ PhonemeSet PhonemeSet::load(const std::filesystem::path& file) {
         PhonemeClass c{entry.getString("name"), entry.getString("group"),
                        entry.optString("examples").value_or(""),
                        entry.optBool("vowel").value_or(false)};
+        if (const auto jaw = entry.optNumber("jaw")) {
+            if (!(*jaw >= 0 && *jaw <= 1)) entry.fail("jaw", "must be in [0, 1]");
+            c.jaw = static_cast<float>(*jaw);
+        }
         entry.finish();
         classes.push_back(std::move(c));
     }

@@ -28,11 +28,14 @@ struct ClipMaker::Impl {
                                         : dsp::TemplateSet::load(findDataFile(c.templates))),
           poseNames(poses.names()) {}
 
-    PoseTrack animate(const PhonemeSchedule& s) const {
+    // The mouth for a schedule, opened as wide as the speech (`samples`) is loud.
+    PoseTrack animate(const PhonemeSchedule& s, std::span<const float> samples, int rate) const {
         lipsync::RuntimeConfig rc;
         rc.outputRate = config.outputRateHz;
-        return config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc)
-                                          : lipsync::animate(s, curves, poses, rc);
+        auto track = config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc)
+                                                : lipsync::animate(s, curves, poses, rc);
+        lipsync::shapeByLoudness(poses, dsp::measureLevels(samples, rate), track);
+        return track;
     }
 };
 
@@ -69,7 +72,11 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
     // Analysed on `channel` (the voice), played on the others (what the audience hears); the
     // analysis first, so its buffers are gone before the sound's is made.
     const auto result = dsp::analyzeFile(file, impl_->templates, PhonemeSet::common(), {}, decode);
-    clip.weights = impl_->animate(result.schedule);
+    {
+        // The mouth opens as wide as the voice is loud: its samples, gone before the sound's.
+        const auto voice = dsp::readAudioFile(file, decode);
+        clip.weights = impl_->animate(result.schedule, voice.samples, voice.sampleRate);
+    }
     dsp::DecodeOptions play;
     play.skipChannel = channel;
     clip.samples = decodeForPlayback(file, play, clip.rate);
@@ -84,7 +91,11 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;
     clip.samples = speech.samples;
-    clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr));
+    std::vector<float> voice(speech.samples.size());  // for its loudness, then gone
+    std::transform(speech.samples.begin(), speech.samples.end(), voice.begin(),
+                   [](std::int16_t x) { return static_cast<float>(x) / 32768.0f; });
+    clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr),
+                                  voice, clip.rate);
     return clip;
 }
 
@@ -100,23 +111,43 @@ class StreamingLive : public ClipMaker::Live {
     StreamingLive(const dsp::TemplateSet& templates, const lipsync::BigramCurveSet& curves,
                   const lipsync::PoseSet& poses, double outputRate, int rate)
         : analyzer_(templates, PhonemeSet::common(), rate),
-          runtime_(curves, poses, 0, config(outputRate)) {
+          runtime_(curves, poses, 0, config(outputRate)),
+          shaper_(poses) {
         analyzer_.onSegment([this](const PhonemeSegment& s) { runtime_.push(s, *out_); });
         // The newest frame's class stands for the phoneme still open (the segmenter has not
         // closed it yet): the mouth starts moving without waiting for the phoneme to end.
         analyzer_.onFrame([this](const dsp::StreamingAnalyzer::Frame& f) {
             openPhoneme_ = PhonemeSet::common()[static_cast<std::size_t>(f.label.phoneme)].name;
             openUntil_ = f.label.time;
+            levels_[frames_++ % levels_.size()] = {f.label.time, f.label.energyDb};
         });
     }
     void push(std::span<const float> samples, PoseTrack& out) override {
         out_ = &out;
         analyzer_.push(samples);
         if (!openPhoneme_.empty()) runtime_.preview(openPhoneme_, openUntil_, out);
+        shapeNewFrames(out);
     }
     double latencySeconds() const override { return analyzer_.latencySeconds(); }
 
   private:
+    // Louder speech opens wider: each new weight frame by the level of the audio frame nearest
+    // its time among the recent ones (a fixed ring: nothing allocates here).
+    void shapeNewFrames(PoseTrack& out) {
+        // The caller may clear the track between pushes: frames are told apart by their time.
+        const std::size_t poses = out.poses.size();
+        for (std::size_t f = 0; f < out.frames(); ++f) {
+            const double t = out.times[f];
+            if (t <= shapedUntil_) continue;
+            float db = -120;
+            double nearest = 1e9;
+            for (const auto& l : levels_)
+                if (std::abs(l.time - t) < nearest) nearest = std::abs(l.time - t), db = l.db;
+            shaper_.shape(db, t - shapedUntil_,
+                          std::span<float>(out.values).subspan(f * poses, poses));
+            shapedUntil_ = t;
+        }
+    }
     static lipsync::RuntimeConfig config(double rate) {
         lipsync::RuntimeConfig c;
         c.outputRate = rate;
@@ -124,9 +155,17 @@ class StreamingLive : public ClipMaker::Live {
     }
     dsp::StreamingAnalyzer analyzer_;
     lipsync::StreamingRuntime runtime_;
+    lipsync::LoudnessShaper shaper_;
     PoseTrack* out_ = nullptr;
     std::string openPhoneme_;
     double openUntil_ = 0;
+    struct Level {
+        double time = -1e9;
+        float db = -120;
+    };
+    std::array<Level, 32> levels_{};  // the last 320 ms of audio frames
+    std::size_t frames_ = 0;
+    double shapedUntil_ = -1e9;  // the last weight frame shaped
 };
 }  // namespace
 

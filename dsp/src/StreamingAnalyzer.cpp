@@ -61,8 +61,13 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     result.inputRate = decoder.sampleRate();
     StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
     analyzer.onSegment([&](const PhonemeSegment& s) { result.schedule.push_back(s); });
-    if (keepFrames)
-        analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) { result.frames.push_back(f); });
+    double lastFrameTime = 0;
+    analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
+        if (result.levels.db.empty()) result.levels.start = f.label.time;
+        result.levels.db.push_back(f.label.energyDb);
+        lastFrameTime = f.label.time;
+        if (keepFrames) result.frames.push_back(f);
+    });
     std::vector<float> block(kReadBlock);
     std::int64_t total = 0;
     while (const auto n = decoder.read(block)) {
@@ -74,6 +79,9 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     result.durationSeconds = static_cast<double>(total) / decoder.sampleRate();
     result.nonFiniteSamples = decoder.nonFiniteSamples();
     if (!result.schedule.empty()) result.schedule.back().end = result.durationSeconds;
+    if (result.levels.db.size() > 1)  // frames are a hop apart, whatever the templates chose
+        result.levels.rate = static_cast<double>(result.levels.db.size() - 1) /
+                             (lastFrameTime - result.levels.start);
     return result;
 }
 

@@ -33,6 +33,7 @@ PoseTrack animate(std::span<const PhonemeSegment> schedule, const BigramCurveSet
         for (std::size_t p = 0; p < poses.size(); ++p)
             smoothValleys(curves.values[p], curves.rate, poses[p].smoothingWindow);
     if (config.constraints) applyConstraints(poses, curves);
+    if (config.restInPauses) restInPauses(schedule, phonemes, poses.rest(), curves);
     if (config.speedLimits) {
         const std::vector<float> rest(poses.size(), 0.0f);  // the mouth starts at rest
         limitSpeed(poses, config.constraints, rest, curves);

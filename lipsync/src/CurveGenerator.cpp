@@ -17,6 +17,8 @@ struct Rules {
     std::vector<std::size_t> closureClasses, releasePoses, leadPoses, roundingPoses;
     std::size_t closurePose = 0;
     float closureValue = 1, leadAmount = 0, anticipation = 0, carryover = 0;
+    std::optional<std::size_t> jawPose;  // targets from the phoneme set's jaw heights
+    double jawHold = 0;                  // its own plateau half-width
 };
 
 std::size_t poseIndex(const TomlTable& t, const std::string& key, const std::string& name,
@@ -40,9 +42,23 @@ float fraction(const TomlTable& t, const std::string& key) {
     return static_cast<float>(v);
 }
 
+// The jaw pose's target in every class is the class's jaw height (config/phonemes/common.toml),
+// the one table the eval reference is built from too.
+void readJaw(const TomlTable& root, const PoseSet& poses, const PhonemeSet& phonemes, Rules& r) {
+    const auto j = root.optTable("jaw");
+    if (!j) return;
+    r.jawPose = poseIndex(*j, "pose", j->getString("pose"), poses);
+    r.jawHold = fraction(*j, "hold");
+    j->finish();
+    for (std::size_t c = 0; c < phonemes.size(); ++c) {
+        if (!phonemes[c].jaw)
+            j->fail("pose", "phoneme class '" + phonemes[c].name + "' has no jaw height");
+        r.targets[c][*r.jawPose] = *phonemes[c].jaw;
+    }
+}
+
 void readTargets(const TomlTable& table, const PoseSet& poses, const PhonemeSet& phonemes,
                  Rules& r) {
-    r.targets.assign(phonemes.size(), std::vector<float>(poses.size(), 0.0f));
     std::vector<bool> seen(phonemes.size(), false);
     for (const auto& cls : table.keys()) {
         const auto c = phonemes.find(cls);
@@ -50,8 +66,12 @@ void readTargets(const TomlTable& table, const PoseSet& poses, const PhonemeSet&
         seen[*c] = true;
         const auto target = table.optTable(cls);
         if (!target) table.fail(cls, "expected a table of pose = weight");
-        for (const auto& pose : target->keys())
-            r.targets[*c][poseIndex(*target, pose, pose, poses)] = fraction(*target, pose);
+        for (const auto& pose : target->keys()) {
+            const auto p = poseIndex(*target, pose, pose, poses);
+            if (p == r.jawPose)
+                target->fail(pose, "the jaw's targets are the phoneme set's jaw heights");
+            r.targets[*c][p] = fraction(*target, pose);
+        }
         target->finish();
     }
     for (std::size_t c = 0; c < phonemes.size(); ++c)
@@ -69,6 +89,12 @@ Rules readRules(const TomlTable& root, const PoseSet& poses, const PhonemeSet& p
         root.fail("hold", "the two held plateaus must lie inside (0, 1) and apart");
     const auto targets = root.optTable("targets");
     if (!targets) root.fail("targets", "missing [targets]");
+    r.targets.assign(phonemes.size(), std::vector<float>(poses.size(), 0.0f));
+    readJaw(root, poses, phonemes, r);
+    if (r.jawPose &&
+        !(r.firstCentre - r.jawHold > 0 && r.firstCentre + r.jawHold < r.secondCentre - r.jawHold &&
+          r.secondCentre + r.jawHold < 1))
+        root.fail("jaw", "the jaw's held plateaus must lie inside (0, 1) and apart");
     readTargets(*targets, poses, phonemes, r);
     if (const auto c = root.optTable("closure")) {
         for (const auto& n : c->optStringArray("classes").value_or(std::vector<std::string>{})) {
@@ -118,11 +144,12 @@ std::vector<ControlPoint> polygonFor(const Rules& r, const PhonemeSet& set, std:
         if (aConsonant && bVowel) va = std::max(va, r.anticipation * vb);
         if (aVowel && bConsonant) vb = std::max(vb, r.carryover * va);
     }
+    const double h = pose == r.jawPose ? r.jawHold : r.hold;
     double cb = r.secondCentre;
     if (bVowel && contains(r.leadPoses, pose))
-        cb = std::max(r.firstCentre + 2 * r.hold + 0.01, cb - r.leadAmount);
+        cb = std::max(r.firstCentre + 2 * h + 0.01, cb - r.leadAmount);
     const auto f = [](double x) { return static_cast<float>(x); };
-    const double ca = r.firstCentre, h = r.hold;
+    const double ca = r.firstCentre;
     return {{0, va / 2},     {f(ca - h), va}, {f(ca), va},     {f(ca + h), va},
             {f(cb - h), vb}, {f(cb), vb},     {f(cb + h), vb}, {1, vb / 2}};
 }

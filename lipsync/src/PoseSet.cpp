@@ -6,8 +6,12 @@
 
 namespace lipsyncd::lipsync {
 
-PoseSet::PoseSet(std::string name, std::vector<Pose> poses, std::vector<PoseConstraint> constraints)
-    : name_(std::move(name)), poses_(std::move(poses)), constraints_(std::move(constraints)) {
+PoseSet::PoseSet(std::string name, std::vector<Pose> poses, std::vector<PoseConstraint> constraints,
+                 RestRule rest)
+    : name_(std::move(name)),
+      poses_(std::move(poses)),
+      constraints_(std::move(constraints)),
+      rest_(rest) {
     // Section 2.2.2 resolves each constraint by priority; applying the ones whose winning pose
     // ranks highest first means a pose is final before it limits anything lower.
     std::stable_sort(constraints_.begin(), constraints_.end(), [&](const auto& a, const auto& b) {
@@ -60,6 +64,18 @@ std::vector<PoseConstraint> readConstraints(const TomlTable& root, const std::ve
     }
     return out;
 }
+RestRule readRest(const TomlTable& root) {
+    RestRule rest;
+    if (const auto t = root.optTable("rest")) {
+        rest.minPause = t->optNumber("min_pause").value_or(rest.minPause);
+        if (!(rest.minPause >= 0 && rest.minPause <= 10))
+            t->fail("min_pause", "must be in [0, 10] s");
+        rest.within = positive(*t, "within", rest.within);
+        if (rest.within > 1) t->fail("within", "must be at most 1 s");
+        t->finish();
+    }
+    return rest;
+}
 }  // namespace
 
 PoseSet PoseSet::load(const std::filesystem::path& file) {
@@ -78,13 +94,17 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
         p.priority = static_cast<int>(t.optInteger("priority").value_or(0));
         p.speedLimit = positive(t, "speed_limit", speed);
         p.smoothingWindow = positive(t, "smoothing_window", window);
+        p.loudnessGain = t.optNumber("loudness_gain").value_or(0);
+        if (!(p.loudnessGain >= 0 && p.loudnessGain <= 1))
+            t.fail("loudness_gain", "must be in [0, 1]");
         t.finish();
         poses.push_back(std::move(p));
     }
     if (poses.empty()) throw InputError(file.string(), 0, "no [[pose]] defined");
     auto constraints = readConstraints(root, poses);
+    const auto rest = readRest(root);
     root.finish();
-    return PoseSet(name, std::move(poses), std::move(constraints));
+    return PoseSet(name, std::move(poses), std::move(constraints), rest);
 }
 
 PoseSet PoseSet::named(const std::string& nameOrPath) {

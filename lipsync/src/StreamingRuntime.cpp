@@ -88,6 +88,10 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
             smoothValleys(curves.values[p], rate, (*poses_)[p].smoothingWindow);
     const std::size_t from = emitted_ - firstFrame;
     if (config_.constraints) applyConstraints(*poses_, curves, from);
+    // The newest segment counts as the end: if it is silence, speech may have stopped, and the
+    // mouth must not wait for the next segment to find out (a live puppet would hang open).
+    if (config_.restInPauses)
+        restInPauses(schedule, *phonemes_, poses_->rest(), curves, from, {atStart_, true});
     if (config_.speedLimits) limitSpeed(*poses_, config_.constraints, last_, curves, from);
 
     const std::size_t end = static_cast<std::size_t>(lastFrame) + 1 - firstFrame;

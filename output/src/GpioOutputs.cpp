@@ -80,7 +80,8 @@ std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> realOpener(const
 }  // namespace
 
 GpioServoSink::GpioServoSink(const Puppet& puppet,
-                             std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open) {
+                             std::function<std::unique_ptr<GpioLine>(const ActuatorConfig&)> open)
+    : puppet_(&puppet) {
     if (!open) open = realOpener(puppet);
     std::vector<ServoPwm::Servo> servos;
     double frequency = 50;
@@ -97,7 +98,9 @@ GpioServoSink::GpioServoSink(const Puppet& puppet,
 
 void GpioServoSink::write(double, std::span<const ActuatorCommand> commands) {
     for (std::size_t k = 0; k < actuator_.size(); ++k)
-        pwm_->set(k, commands[actuator_[k]].value, commands[actuator_[k]].active);
+        pwm_->setPulse(k,
+                       servoPulseUs(puppet_->actuators[actuator_[k]], commands[actuator_[k]].value),
+                       commands[actuator_[k]].active);  // (through the linkage, if any)
 }
 
 GpioSwitchSink::GpioSwitchSink(
@@ -131,6 +134,7 @@ void addHardwareSinks(PuppetDriver& driver, const Puppet& puppet,
     if (uses(Backend::Switch)) driver.addSink(std::make_unique<GpioSwitchSink>(puppet));
     for (const auto& h : puppet.hidDevices)
         driver.addSink(std::make_unique<HidSink>(puppet, h, openHidapiDevice, log));
+    addServoBoardSinks(driver, puppet, log);
 }
 
 }  // namespace lipsyncd::output

@@ -9,6 +9,8 @@
 #include <ostream>
 #include <set>
 
+#include "PuppetBoards.hpp"
+
 namespace lipsyncd::output {
 
 namespace {
@@ -18,7 +20,9 @@ Backend backendOf(const TomlTable& t) {
     if (b == "switch") return Backend::Switch;
     if (b == "hid") return Backend::Hid;
     if (b == "virtual") return Backend::Virtual;
-    t.fail("backend", "'" + b + "' is not a backend (servo, switch, hid, virtual)");
+    if (const auto board = boardBackend(b)) return *board;
+    t.fail("backend",
+           "'" + b + "' is not a backend (servo, switch, hid, virtual, pca9685, maestro, pwm)");
 }
 
 double number(const TomlTable& t, const std::string& key, double fallback, double lo, double hi) {
@@ -43,10 +47,11 @@ void readAddress(const TomlTable& t, ActuatorConfig& a) {
         a.hidDevice = t.getString("device");
         a.hidChannel = static_cast<unsigned>(number(t, "channel", 0, 0, 4095));
     }
+    readBoardAddress(t, a);
 }
 
 void readBackendSettings(const TomlTable& t, ActuatorConfig& a) {
-    if (a.backend == Backend::Servo) {
+    if (takesServoPulses(a.backend)) {
         a.pulseMinUs = number(t, "pulse_min_us", 1000, 100, 3000);
         a.pulseMaxUs = number(t, "pulse_max_us", 2000, 100, 3000);
         a.frequencyHz = number(t, "frequency", 50, 10, 400);
@@ -106,6 +111,7 @@ ActuatorConfig readActuator(const TomlTable& t) {
     a.slew = number(t, "slew", 5 * (a.max - a.min), 1e-6, 1e9);
     a.idleAfter = number(t, "idle_after", 2, 0, 3600);
     readBackendSettings(t, a);
+    readLinkage(t, a);
     t.finish();
     return a;
 }
@@ -163,6 +169,7 @@ void checkDuplicates(const Puppet& p, const TomlTable& root) {
         }
     }
     (void)root;
+    checkBoardChannels(p);
 }
 }  // namespace
 
@@ -196,7 +203,8 @@ void Puppet::checkPoses(std::span<const std::string> poses) const {
 }
 
 void Puppet::describe(std::ostream& out) const {
-    static const char* kBackend[] = {"servo", "switch", "hid", "virtual"};
+    static const char* kBackend[] = {"servo",   "switch",  "hid", "virtual",
+                                     "pca9685", "maestro", "pwm"};
     out << "puppet '" << name << "' (" << source.string() << "): " << actuators.size()
         << " actuator(s), rest after " << stallTimeout << " s without input\n";
     for (const auto& a : actuators) {
@@ -204,12 +212,13 @@ void Puppet::describe(std::ostream& out) const {
         if (a.backend == Backend::Servo || a.backend == Backend::Switch)
             out << " " << a.chip << " line " << a.gpioLine;
         if (a.backend == Backend::Hid) out << " " << a.hidDevice << " channel " << a.hidChannel;
+        describeBoardAddress(out, a);
         out << "]\n    value = " << a.neutral + a.trim;
         for (const auto& [pose, gain] : a.gains)
             out << (gain < 0 ? " - " : " + ") << std::abs(gain) << "·" << pose;
         out << (a.invert ? ", inverted" : "") << "; limits " << a.min << " .. " << a.max
             << ", rest " << a.rest << ", slew " << a.slew << "/s, deadband " << a.deadband;
-        if (a.backend == Backend::Servo)
+        if (takesServoPulses(a.backend))
             out << "\n    pulses " << a.pulseMinUs << " .. " << a.pulseMaxUs << " µs at "
                 << a.frequencyHz << " Hz, relax after " << a.idleAfter << " s at rest";
         if (a.backend == Backend::Switch)
@@ -217,6 +226,7 @@ void Puppet::describe(std::ostream& out) const {
                 << a.threshold - a.hysteresis / 2 << ", at least " << a.minOnSeconds << " s on / "
                 << a.minOffSeconds << " s off";
         out << '\n';
+        describeLinkage(out, a);
     }
     for (const auto& h : hidDevices)
         out << "  hid '" << h.name << "': " << (h.path.empty() ? "" : h.path + " ") << std::hex

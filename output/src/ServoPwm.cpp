@@ -61,7 +61,10 @@ ServoPwm::~ServoPwm() {
 
 void ServoPwm::set(std::size_t servo, double value, bool active) {
     const auto& s = servos_[servo];
-    const double us = pulseUs(value, s.min, s.max, s.pulseMinUs, s.pulseMaxUs);
+    setPulse(servo, pulseUs(value, s.min, s.max, s.pulseMinUs, s.pulseMaxUs), active);
+}
+
+void ServoPwm::setPulse(std::size_t servo, double us, bool active) {
     pulseNs_[servo].store(active ? static_cast<std::int64_t>(us * 1000) : 0,
                           std::memory_order_relaxed);
 }

@@ -17,9 +17,9 @@ namespace fs = std::filesystem;
 fs::path weightsFile(const fs::path& dir, double seconds = 1.0) {
     const auto path = dir / "w.csv";
     std::ofstream out(path);
-    out << "time,open,wide,w,pbm,fv,shch,tongue_up,tongue_down,tongue_back\n";
+    out << "time,jaw,open,wide,w,pbm,fv,shch,tongue_up,tongue_down,tongue_back\n";
     for (int f = 0; f * 0.01 <= seconds + 1e-9; ++f)
-        out << f * 0.01 << ",0.8,0.2,0,0,0,0,0.3,0,0\n";
+        out << f * 0.01 << ",0.8,0.8,0.2,0,0,0,0,0.3,0,0\n";
     return path;
 }
 

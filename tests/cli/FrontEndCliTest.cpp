@@ -6,6 +6,7 @@
 #include <fstream>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/dsp.hpp>
+#include <nlohmann/json.hpp>
 
 #include "RunLipsync.hpp"
 
@@ -108,6 +109,35 @@ TEST(LipsyncCli, EvalFailsBelowTheFloorAndPassesAboveIt) {
     const auto r = runLipsync({"eval", "--corpus", dir.string(), "--min-accuracy", "0.999"});
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.err.find("below the floor"), std::string::npos) << r.err;
+}
+
+// One subfolder per speaker: the jaw is scored per speaker, three ways, through the puppet.
+TEST(LipsyncCli, EvalScoresThePuppetsJawPerSpeaker) {
+    const auto dir = scratchDir("cli_eval_speakers");
+    for (const auto* speaker : {"alice", "bob"}) {
+        std::filesystem::create_directories(dir / speaker);
+        std::filesystem::copy_file(exampleWav(), dir / speaker / "hello.wav");
+        auto lab = exampleWav();
+        std::filesystem::copy_file(lab.replace_extension(".lab"), dir / speaker / "hello.lab");
+    }
+    const auto r = runLipsync({"eval", "--corpus", dir.string(), "--json", "-", "--no-per-file",
+                               "--puppet", "jaw-servo"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto json = nlohmann::json::parse(r.out.substr(r.out.find("\n{") + 1));
+    for (const auto* speaker : {"alice", "bob"}) {
+        const auto& jaw = json["speakers"][speaker]["jaw"];
+        EXPECT_GT(jaw["labels"]["r"].get<double>(), 0.8) << speaker;
+        EXPECT_GT(jaw["audio"]["r"].get<double>(), jaw["envelope"]["r"].get<double>() - 0.3);
+        EXPECT_GE(jaw["labels"]["closures_caught"].get<double>(), 0.9);
+        EXPECT_LE(jaw["labels"]["false_closures"].get<double>(), 0.05);
+    }
+    EXPECT_NE(r.out.find("jaw through 'jaw-servo'"), std::string::npos) << r.out;
+    const auto floor = runLipsync({"eval", "--corpus", dir.string(), "--min-exact-jaw-r", "0.999"});
+    EXPECT_EQ(floor.exitCode, 1);
+    EXPECT_NE(floor.err.find("jaw r from the labels"), std::string::npos) << floor.err;
+    const auto bad = runLipsync({"eval", "--corpus", dir.string(), "--jaw-actuator", "tail"});
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("no actuator named 'tail'"), std::string::npos) << bad.err;
 }
 
 TEST(LipsyncCli, EvalOnAFolderWithoutLabelsSaysSo) {

@@ -116,10 +116,10 @@ TEST(PlotCli, DrawsACurvePerPoseAndThePhonemesUnderThem) {
     const auto text = slurp(svg);
     EXPECT_EQ(text.rfind("<?xml", 0), 0u);
     EXPECT_NE(text.find("</svg>"), std::string::npos);
-    EXPECT_EQ(count(text, "<polyline class=\"pose\""), 9u);  // the FaceFX-style poses
+    EXPECT_EQ(count(text, "<polyline class=\"pose\""), 10u);  // the FaceFX-style poses + jaw
     EXPECT_NE(text.find("data-pose=\"pbm\""), std::string::npos);
     EXPECT_EQ(
-        count(text, "<text x=") - count(text, " s</text>") - 3 /* axis values */ - 9 /* legend */,
+        count(text, "<text x=") - count(text, " s</text>") - 3 /* axis values */ - 10 /* legend */,
         readScheduleFile(schedule).size());
     // Bad input names the file.
     std::ofstream(dir / "bad.csv") << "time,open\n0,0.1\n0.01\n";

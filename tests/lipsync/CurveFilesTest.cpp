@@ -106,8 +106,8 @@ TEST(CurveFiles, MandarinAddsOneClassWithItsPairsOnTopOfEnglish) {
 }
 
 TEST(CurveFiles, ErrorsNameTheBigramAndPose) {
-    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"jaw": [[0,0],[1,0]]}}})")
-                  .find("bigrams.aa-bmp.jaw: unknown pose"),
+    EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"chin": [[0,0],[1,0]]}}})")
+                  .find("bigrams.aa-bmp.chin: unknown pose"),
               std::string::npos);
     EXPECT_NE(errorLoading(kHead + R"({"aa-bmp": {"open": [[0,0],[0.6,0.2],[0.5,0.1],[1,0]]}}})")
                   .find("bigrams.aa-bmp.open[2]: times must increase"),

@@ -177,7 +177,7 @@ TEST(PuppetFiles, PosesTheWeightsLackAreNamed) {
         p.checkPoses(std::vector<std::string>{"open"});
         FAIL();
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("pose 'pbm'"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("pose 'jaw'"), std::string::npos) << e.what();
     }
 }
 

@@ -53,6 +53,10 @@ struct PhonemeClass {
     std::string group;     // coarse visual group: silence, open, mid, rounded, closed, ...
     std::string examples;  // words that show it, for people reading a report
     bool vowel = false;
+    // How far the jaw opens for this class in running speech, 0 (closed, as at a bilabial
+    // closure) to 1 (the widest opening of speech): the puppet's jaw target and the reference
+    // `lipsync eval` scores a jaw against. Sources in config/phonemes/common.toml.
+    std::optional<float> jaw;
 };
 
 class PhonemeSet {
@@ -154,6 +158,20 @@ void writeSchedule(std::ostream& out, std::span<const PhonemeSegment> schedule,
                    bool withConfidence = true);
 // JSON array of {"start","end","phoneme","confidence"}.
 void writeScheduleJson(std::ostream& out, std::span<const PhonemeSegment> schedule);
+
+// ---------------------------------------------------------------------------------------------
+// Loudness.
+
+// The speech level over time, one value per analysis frame (frame f is at start + f / rate):
+// what Lewis's analysis reports as each frame's excitation volume, used to let louder speech
+// open the mouth wider (lipsync::shapeByLoudness).
+struct LevelTrack {
+    double start = 0;       // seconds: time of frame 0
+    double rate = 100;      // frames per second
+    std::vector<float> db;  // frame RMS in dBFS
+    // The level at time t (nearest frame; the first/last frame outside the track).
+    float at(double t) const;
+};
 
 // ---------------------------------------------------------------------------------------------
 // Pose weights.

@@ -386,12 +386,32 @@ class StreamingAnalyzer {
 
 struct AnalysisResult {
     PhonemeSchedule schedule;
+    LevelTrack levels;                             // every frame's RMS level (dBFS)
     std::vector<StreamingAnalyzer::Frame> frames;  // only when asked for
     double durationSeconds = 0;
     int inputRate = 0;
     double resamplerDelaySeconds = 0;
     std::int64_t nonFiniteSamples = 0;
 };
+
+// ---------------------------------------------------------------------------------------------
+// Loudness.
+
+// Frame RMS levels (dBFS) of audio in memory, `frameRate` frames a second, each over a window
+// of `windowSeconds` centred on the frame.
+LevelTrack measureLevels(std::span<const float> samples, int sampleRate, double frameRate = 100,
+                         double windowSeconds = 0.03);
+
+// A loudness envelope follower, as the jaw boards sold for animatronics drive a servo: the
+// amplitude envelope (fast attack, slower release), a noise gate, and a gain set so that the
+// voice's speaking level opens the jaw fully. One value in [0, 1] per level frame.
+struct EnvelopeFollowerConfig {
+    double attackSeconds = 0.01, releaseSeconds = 0.06;
+    double gateBelowPeakDb = 35;    // quieter than this below the loudest frame: closed
+    double fullAtPercentile = 0.9;  // of the frames above the gate: fully open
+};
+std::vector<float> followEnvelope(const LevelTrack& levels,
+                                  const EnvelopeFollowerConfig& config = {});
 
 // ---------------------------------------------------------------------------------------------
 // Training and evaluation.

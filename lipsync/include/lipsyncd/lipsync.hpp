@@ -33,6 +33,16 @@ struct Pose {
     int priority = 0;               // on a constraint, the lower-priority pose gives way
     double speedLimit = 6.0;        // weight units per second (section 2.2.3)
     double smoothingWindow = 0.18;  // 2·t_w, seconds (section 2.2.1)
+    // How much of the pose's weight speech loudness controls (shapeByLoudness): 0 none, 1 all.
+    double loudnessGain = 0;
+};
+
+// The mouth rests when speech stops: from the start of a silence at least `minPause` long (and
+// at the end of a schedule) every pose is at 0 within `within` seconds, and stays there until
+// `within` before the next phoneme starts (restInPauses).
+struct RestRule {
+    double minPause = 0.25;
+    double within = 0.12;
 };
 
 // C(a, b): when c_a + c_b > threshold, the lower-priority of the two is reduced (2.2.2).
@@ -54,13 +64,16 @@ class PoseSet {
     std::optional<std::size_t> find(const std::string& name) const;
     // In the order they are applied: by the higher pose's priority, highest first.
     std::span<const PoseConstraint> constraints() const { return constraints_; }
+    const RestRule& rest() const { return rest_; }
 
-    PoseSet(std::string name, std::vector<Pose> poses, std::vector<PoseConstraint> constraints);
+    PoseSet(std::string name, std::vector<Pose> poses, std::vector<PoseConstraint> constraints,
+            RestRule rest = {});
 
   private:
     std::string name_;
     std::vector<Pose> poses_;
     std::vector<PoseConstraint> constraints_;
+    RestRule rest_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -144,6 +157,7 @@ struct RuntimeConfig {
     bool smoothing = true;
     bool constraints = true;
     bool speedLimits = true;
+    bool restInPauses = true;
 };
 
 // Pose weights over time, one row of `poses` values per output frame: the runtime's working
@@ -181,6 +195,43 @@ void applyConstraints(const PoseSet& poses, PoseCurves& curves, std::size_t from
 // never re-breaks a constraint (2.2.3).
 void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const float> previous,
                 PoseCurves& curves, std::size_t fromFrame = 0);
+
+// Silences at least rest.minPause long, and a silence that opens or closes the schedule (where
+// `bracket` says it starts or ends there): every pose is scaled by a ramp that reaches 0
+// `within` after the silence starts and leaves 0 `within` before it ends, so the mouth rests in
+// pauses and after speech whatever the curves hold. Runs after the constraints (it only lowers
+// weights) and before the speed limits, which then smooth it.
+void restInPauses(std::span<const PhonemeSegment> schedule, const PhonemeSet& phonemes,
+                  const RestRule& rest, PoseCurves& curves, std::size_t fromFrame = 0,
+                  Bracket bracket = {});
+
+// Louder speech opens wider, within the opening a phoneme allows (Lewis 1991 reports each
+// frame's excitation volume for this). A pose with loudness gain g is scaled by
+// 1 − g + g·s, where s in [0, 1] is the frame's level relative to the utterance's speaking
+// level L (0 at L − rangeDb, 1 at L and above). It only ever lowers a weight, so a closure (a
+// nasal m, a bilabial) stays closed however loud it is, and rest stays rest.
+struct LoudnessConfig {
+    double rangeDb = 18;            // from "quiet" (s = 0) to the speaking level (s = 1)
+    double percentile = 0.9;        // offline: L is this percentile of the speech frames' levels
+    double speechBelowPeakDb = 40;  // frames this far below the loudest are not speech
+    double peakDecayDbPerS = 3;     // streaming: L is a peak that decays this fast
+};
+// Offline: L from the whole utterance. `levels` are frame RMS in dBFS (dsp::measureLevels).
+void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
+                     const LoudnessConfig& config = {});
+// Streaming: L is a decaying peak of the levels seen so far; frames are shaped as they leave.
+class LoudnessShaper {
+  public:
+    LoudnessShaper(const PoseSet& poses, const LoudnessConfig& config = {});
+    // Shapes one frame of weights (poses in pose-set order) at a level of `db`, `dt` seconds
+    // after the previous call.
+    void shape(float db, double dt, std::span<float> weights);
+
+  private:
+    std::vector<double> gains_;
+    LoudnessConfig config_;
+    double peak_ = -120;
+};
 
 // The whole runtime over a schedule (contiguous, common-set names).
 PoseTrack animate(std::span<const PhonemeSegment> schedule, const BigramCurveSet& set,
@@ -232,5 +283,42 @@ class StreamingRuntime {
     std::size_t emitted_ = 0;  // frames already out
     std::vector<float> last_;  // the last frame out
 };
+
+// ---------------------------------------------------------------------------------------------
+// Scoring a jaw.
+
+// How a puppet's jaw is judged against reference labels (`lipsync eval`). Jaw values are
+// normalised to the jaw's travel: 0 closed, 1 fully open.
+struct JawScoreConfig {
+    double smoothingSeconds = 0.04;      // the reference: each phoneme's jaw height, moving average
+    double closedBelow = 0.15;           // a jaw below this shows a closed mouth
+    double clearlyOpenAbove = 0.5;       // a reference above this is a clearly open mouth
+    double closureMarginSeconds = 0.03;  // a closure counts if the jaw closes within its ± this
+};
+
+// The reference jaw: frame f (at f / rate seconds) holds the jaw height of the phoneme labelled
+// there (PhonemeClass::jaw), smoothed by a centred moving average. InputError for a set without
+// jaw heights.
+std::vector<float> jawReference(std::span<const PhonemeSegment> labels, const PhonemeSet& set,
+                                double rate, std::size_t frames, const JawScoreConfig& config = {});
+
+struct JawScore {
+    // Sums for Pearson's r over every frame scored (so scores of files add up to a speaker's).
+    double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    // Closures inside speech (a "closed"-group phoneme between two non-silent ones) and how many
+    // of them the jaw showed; frames where the reference is clearly open and how many of them
+    // the jaw showed closed.
+    std::size_t closures = 0, closuresCaught = 0, openFrames = 0, falseClosures = 0;
+
+    double r() const;  // Pearson correlation of jaw and reference; 0 when either is constant
+    double closureRate() const { return closures ? double(closuresCaught) / closures : 1.0; }
+    double falseClosureRate() const {
+        return openFrames ? double(falseClosures) / openFrames : 0.0;
+    }
+    void add(const JawScore& other);
+};
+JawScore scoreJaw(std::span<const float> jaw, std::span<const float> reference,
+                  std::span<const PhonemeSegment> labels, const PhonemeSet& set, double rate,
+                  const JawScoreConfig& config = {});
 
 }  // namespace lipsyncd::lipsync

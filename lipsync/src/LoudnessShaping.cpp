@@ -1,0 +1,63 @@
+// Louder speech opens the mouth wider. Lewis (1991) computes each frame's excitation volume
+// beside its spectrum for exactly this: the spectrum says which mouth shape, the volume says how
+// far. Here the phoneme's pose weight is the most the mouth may open, and the level relative to
+// the utterance's speaking level decides how much of it is used.
+#include <algorithm>
+#include <cmath>
+#include <lipsyncd/lipsync.hpp>
+
+namespace lipsyncd::lipsync {
+
+namespace {
+// s in [0, 1]: 0 at `reference − range` and below, 1 at the reference and above.
+double relativeLevel(double db, double reference, double rangeDb) {
+    return std::clamp((db - (reference - rangeDb)) / rangeDb, 0.0, 1.0);
+}
+
+// The speaking level of an utterance: a high percentile of the frames that are speech (within
+// `speechBelowPeakDb` of the loudest), so a single shout or click does not set it.
+double speakingLevel(std::span<const float> db, const LoudnessConfig& config) {
+    if (db.empty()) return -120;
+    const float peak = *std::max_element(db.begin(), db.end());
+    std::vector<float> speech;
+    for (float v : db)
+        if (v >= peak - config.speechBelowPeakDb) speech.push_back(v);
+    const auto k =
+        static_cast<std::size_t>(config.percentile * static_cast<double>(speech.size() - 1));
+    std::nth_element(speech.begin(), speech.begin() + static_cast<std::ptrdiff_t>(k), speech.end());
+    return speech[k];
+}
+
+void scaleFrame(std::span<const double> gains, double s, std::span<float> weights) {
+    for (std::size_t p = 0; p < weights.size(); ++p)
+        weights[p] *= static_cast<float>(1 - gains[p] + gains[p] * s);
+}
+
+std::vector<double> gainsOf(const PoseSet& poses) {
+    std::vector<double> g;
+    for (const auto& p : poses.poses()) g.push_back(p.loudnessGain);
+    return g;
+}
+}  // namespace
+
+void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
+                     const LoudnessConfig& config) {
+    if (levels.db.empty() || track.poses.size() != poses.size()) return;
+    const auto gains = gainsOf(poses);
+    const double reference = speakingLevel(levels.db, config);
+    for (std::size_t f = 0; f < track.frames(); ++f) {
+        const double s = relativeLevel(levels.at(track.times[f]), reference, config.rangeDb);
+        scaleFrame(gains, s,
+                   std::span<float>(track.values).subspan(f * poses.size(), poses.size()));
+    }
+}
+
+LoudnessShaper::LoudnessShaper(const PoseSet& poses, const LoudnessConfig& config)
+    : gains_(gainsOf(poses)), config_(config) {}
+
+void LoudnessShaper::shape(float db, double dt, std::span<float> weights) {
+    peak_ = std::max<double>(db, peak_ - config_.peakDecayDbPerS * std::max(0.0, dt));
+    scaleFrame(gains_, relativeLevel(db, peak_, config_.rangeDb), weights);
+}
+
+}  // namespace lipsyncd::lipsync

@@ -1,0 +1,211 @@
+// The jaw a puppet shows: class order kept through the whole runtime, rest when speech stops,
+// loudness that opens wider but never past a phoneme's opening, and the jaw scores of eval.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <random>
+
+#include "RuntimeTestSupport.hpp"
+
+namespace lipsyncd::test {
+namespace {
+
+struct Shipped {
+    lipsync::PoseSet poses = lipsync::PoseSet::named("facefx");
+    lipsync::BigramCurveSet curves = lipsync::BigramCurveSet::named("english", poses);
+    std::size_t jaw = *poses.find("jaw");
+};
+const Shipped& shipped() {
+    static const Shipped s;
+    return s;
+}
+
+float jawHeight(const std::string& cls) {
+    return *PhonemeSet::common()[*PhonemeSet::common().find(cls)].jaw;
+}
+
+float weightAt(const PoseTrack& track, double t, std::size_t pose) {
+    const auto f = static_cast<std::size_t>(std::lround(t * 100));
+    return track.frame(std::min(f, track.frames() - 1))[pose];
+}
+
+// `n` speech classes (no silence) held `hold` seconds each, in random order, appended to `s`.
+void appendSpeech(std::mt19937& rng, std::size_t n, double hold, PhonemeSchedule& s) {
+    const auto& set = PhonemeSet::common();
+    std::uniform_int_distribution<std::size_t> pick(0, set.size() - 1);
+    for (std::size_t i = 0; i < n; ++i) {
+        std::size_t c;
+        do c = pick(rng);
+        while (c == set.silence());
+        const double t = s.empty() ? 0 : s.back().end;
+        s.push_back({t, t + hold, set[c].name, 1});
+    }
+}
+void appendSilence(double length, PhonemeSchedule& s) {
+    const double t = s.empty() ? 0 : s.back().end;
+    s.push_back({t, t + length, "sil", 1});
+}
+
+TEST(Jaw, EveryClassHasAJawHeightAndTheOrderIsTheArticulatoryOne) {
+    for (const auto& c : PhonemeSet::common().classes()) ASSERT_TRUE(c.jaw) << c.name;
+    // Low vowels most open, then mid, then high; consonants lower; sibilants nearly closed;
+    // bilabials at closure.
+    EXPECT_GT(jawHeight("aa"), jawHeight("eh"));
+    EXPECT_GT(jawHeight("eh"), jawHeight("ih"));
+    EXPECT_GT(jawHeight("ih"), jawHeight("d"));
+    EXPECT_GT(jawHeight("d"), jawHeight("z"));
+    EXPECT_LT(jawHeight("z"), 0.1f);
+    EXPECT_EQ(jawHeight("bmp"), 0.0f);
+}
+
+// Where a phoneme is held long enough for the jaw to reach its target, the jaw at its centre
+// keeps the class order, whatever comes before and after.
+TEST(Jaw, HeldPhonemesKeepTheClassOrderThroughTheWholeRuntime) {
+    std::mt19937 rng(11);
+    for (int trial = 0; trial < 20; ++trial) {
+        PhonemeSchedule s;
+        appendSilence(0.3, s);
+        appendSpeech(rng, 30, 0.25, s);
+        appendSilence(0.5, s);
+        const auto track = lipsync::animate(s, shipped().curves, shipped().poses);
+        for (std::size_t i = 1; i + 1 < s.size(); ++i) {
+            const double centre = (s[i].start + s[i].end) / 2;
+            EXPECT_NEAR(weightAt(track, centre, shipped().jaw), jawHeight(s[i].phoneme), 0.03)
+                << s[i].phoneme << " at " << centre << " s (trial " << trial << ")";
+            for (std::size_t k = 1; k + 1 < s.size(); ++k) {
+                if (jawHeight(s[i].phoneme) < jawHeight(s[k].phoneme) + 0.1) continue;
+                EXPECT_GT(weightAt(track, centre, shipped().jaw),
+                          weightAt(track, (s[k].start + s[k].end) / 2, shipped().jaw))
+                    << s[i].phoneme << " vs " << s[k].phoneme;
+            }
+        }
+    }
+}
+
+TEST(Jaw, ABilabialBetweenOpenVowelsClosesTheJaw) {
+    const PhonemeSchedule s{{0, 0.2, "sil", 1},
+                            {0.2, 0.4, "aa", 1},
+                            {0.4, 0.47, "bmp", 1},
+                            {0.47, 0.7, "aa", 1},
+                            {0.7, 1.0, "sil", 1}};
+    const auto track = lipsync::animate(s, shipped().curves, shipped().poses);
+    float lowest = 1;
+    for (double t = 0.4; t <= 0.47; t += 0.01)
+        lowest = std::min(lowest, weightAt(track, t, shipped().jaw));
+    EXPECT_LT(lowest, 0.1f);
+    EXPECT_GT(weightAt(track, 0.3, shipped().jaw), 0.9f);
+}
+
+// Every pose, not only the jaw: a mouth half open in a pause or after the line reads as broken.
+void expectRestBetween(const PoseTrack& track, double from, double to) {
+    for (std::size_t f = 0; f < track.frames(); ++f) {
+        if (track.times[f] < from - 1e-9 || track.times[f] > to + 1e-9) continue;
+        for (std::size_t p = 0; p < track.poses.size(); ++p)
+            ASSERT_LT(track.frame(f)[p], 1e-4f)
+                << track.poses[p] << " at " << track.times[f] << " s";
+    }
+}
+
+TEST(Jaw, TheMouthRestsWithin150MsOfTheEndOfSpeechAndInPausesOver250Ms) {
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 20; ++trial) {
+        PhonemeSchedule s;
+        appendSilence(0.3, s);
+        appendSpeech(rng, 6, 0.12, s);
+        const double pauseAt = s.back().end;
+        appendSilence(0.3, s);
+        appendSpeech(rng, 6, 0.12, s);
+        appendSilence(0.5, s);
+        const auto track = lipsync::animate(s, shipped().curves, shipped().poses);
+        expectRestBetween(track, s.front().start, s.front().end - 0.1);
+        expectRestBetween(track, pauseAt + 0.15, pauseAt + 0.3 - 0.1);
+        expectRestBetween(track, s.back().start + 0.15, s.back().end);
+    }
+}
+
+TEST(Jaw, TheCausalStreamRestsWithin150MsOfASilenceWithoutWaitingForWhatFollows) {
+    const PhonemeSchedule s{{0, 0.3, "aa", 1}, {0.3, 0.4, "ah", 1}};
+    lipsync::StreamingRuntime stream(shipped().curves, shipped().poses, 0);
+    PoseTrack out;
+    for (const auto& seg : s) stream.push(seg, out);
+    stream.preview("sil", 0.6, out);  // silence so far, its end unknown
+    expectRestBetween(out, 0.55, 0.6);
+}
+
+TEST(Jaw, LouderSpeechOpensWiderButNeverPastThePhonemesOpening) {
+    const PhonemeSchedule s{{0, 0.1, "sil", 1},
+                            {0.1, 0.4, "aa", 1},
+                            {0.4, 0.5, "bmp", 1},
+                            {0.5, 0.8, "aa", 1},
+                            {0.8, 1.0, "sil", 1}};
+    const auto plain = lipsync::animate(s, shipped().curves, shipped().poses);
+    LevelTrack levels;
+    levels.db.assign(101, -20.0f);                                 // speaking level
+    for (std::size_t f = 50; f <= 80; ++f) levels.db[f] = -38.0f;  // the second vowel quiet
+    for (std::size_t f = 40; f < 50; ++f) levels.db[f] = 0.0f;     // a very loud m
+    auto shaped = plain;
+    lipsync::shapeByLoudness(shipped().poses, levels, shaped);
+    const auto jaw = shipped().jaw;
+    for (std::size_t i = 0; i < plain.values.size(); ++i)
+        ASSERT_LE(shaped.values[i], plain.values[i] + 1e-6f);
+    EXPECT_NEAR(weightAt(shaped, 0.25, jaw), weightAt(plain, 0.25, jaw), 0.01);
+    const double gain = shipped().poses[jaw].loudnessGain;
+    EXPECT_NEAR(weightAt(shaped, 0.65, jaw), (1 - gain) * weightAt(plain, 0.65, jaw), 0.01);
+    EXPECT_LT(weightAt(shaped, 0.45, jaw), 0.05f);  // the nasal stays closed however loud
+}
+
+TEST(Jaw, TheStreamingShaperFollowsADecayingPeak) {
+    lipsync::LoudnessShaper shaper(shipped().poses);
+    std::vector<float> w(shipped().poses.size(), 1.0f);
+    shaper.shape(-20, 0.01, w);
+    EXPECT_FLOAT_EQ(w[shipped().jaw], 1.0f);  // at the peak so far
+    std::fill(w.begin(), w.end(), 1.0f);
+    shaper.shape(-50, 0.01, w);
+    EXPECT_NEAR(w[shipped().jaw], 1 - shipped().poses[shipped().jaw].loudnessGain, 1e-6);
+}
+
+TEST(JawScore, TheReferenceAgainstItselfIsPerfectAndAFrozenJawIsNot) {
+    const auto& set = PhonemeSet::common();
+    const PhonemeSchedule s{{0, 0.2, "sil", 1},
+                            {0.2, 0.4, "aa", 1},
+                            {0.4, 0.45, "bmp", 1},
+                            {0.45, 0.7, "eh", 1},
+                            {0.7, 0.9, "sil", 1}};
+    const auto ref = lipsync::jawReference(s, set, 100, 91);
+    EXPECT_NEAR(ref[30], 1.0f, 1e-6);
+    EXPECT_NEAR(ref[10], 0.0f, 1e-6);
+    const auto self = lipsync::scoreJaw(ref, ref, s, set, 100);
+    EXPECT_NEAR(self.r(), 1.0, 1e-9);
+    EXPECT_EQ(self.closures, 1u);
+    EXPECT_EQ(self.closuresCaught, 1u);
+    EXPECT_EQ(self.falseClosures, 0u);
+    const std::vector<float> open(91, 0.6f), shut(91, 0.0f);
+    EXPECT_EQ(lipsync::scoreJaw(open, ref, s, set, 100).closuresCaught, 0u);
+    EXPECT_EQ(lipsync::scoreJaw(open, ref, s, set, 100).r(), 0.0);
+    const auto closed = lipsync::scoreJaw(shut, ref, s, set, 100);
+    EXPECT_GT(closed.openFrames, 10u);
+    EXPECT_EQ(closed.falseClosureRate(), 1.0);
+    auto twice = self;
+    twice.add(closed);
+    EXPECT_EQ(twice.closures, 2u);
+    EXPECT_EQ(twice.n, 2 * self.n);
+}
+
+TEST(Jaw, APoseSetRejectsABadLoudnessGainAndRestRuleNamingTheLine) {
+    const auto file = std::filesystem::temp_directory_path() / "lipsyncd-bad-poses.toml";
+    for (const std::string body : {"[[pose]]\nname = \"jaw\"\nloudness_gain = 1.5\n",
+                                   "[[pose]]\nname = \"jaw\"\n[rest]\nwithin = -1\n"}) {
+        std::ofstream(file) << "name = \"bad\"\n" << body;
+        try {
+            lipsync::PoseSet::load(file);
+            FAIL() << "accepted: " << body;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(file.string() + ":"), std::string::npos)
+                << e.what();
+        }
+    }
+    std::filesystem::remove(file);
+}
+
+}  // namespace
+}  // namespace lipsyncd::test
