@@ -91,11 +91,11 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;
     clip.samples = speech.samples;
-    std::vector<float> voice(speech.samples.size());  // for its loudness, then gone
-    std::transform(speech.samples.begin(), speech.samples.end(), voice.begin(),
+    std::vector<float> level(speech.samples.size());  // for its loudness, then gone
+    std::transform(speech.samples.begin(), speech.samples.end(), level.begin(),
                    [](std::int16_t x) { return static_cast<float>(x) / 32768.0f; });
     clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr),
-                                  voice, clip.rate);
+                                  level, clip.rate);
     return clip;
 }
 
