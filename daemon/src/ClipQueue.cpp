@@ -2,6 +2,7 @@
 // full queue of long clips costs their requests' few bytes, not their audio.
 #include "ClipQueue.hpp"
 
+#include <malloc.h>
 #include <pthread.h>
 
 #include <csignal>
@@ -108,6 +109,7 @@ void ClipQueue::work() {
         } catch (const std::exception& e) {
             failure = request.name + ": " + e.what();
         }
+        ::malloc_trim(0);  // the decoder's and analysis's buffers back to the system
         lock.lock();
         // clear() in the meantime: the front is another request now, or nothing.
         if (generation != generation_ || jobs_.empty()) continue;
