@@ -1,12 +1,9 @@
-// lipsync ctl: the client of lipsyncd's control socket (JSON lines).
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <unistd.h>
-
+// lipsync ctl: the client of lipsyncd's control socket (JSON lines). Requests are built from the
+// daemon's command table and checked against it before they are sent; every wait has a deadline.
 #include <chrono>
-#include <cstring>
 #include <iostream>
 #include <lipsyncd/core.hpp>
+#include <lipsyncd/daemon.hpp>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -15,50 +12,7 @@
 namespace lipsyncd::cli {
 
 namespace {
-// One connection; requests and replies are lines.
-class ControlConnection {
-  public:
-    explicit ControlConnection(const std::string& path) {
-        fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-        sockaddr_un addr{};
-        addr.sun_family = AF_UNIX;
-        std::strncpy(addr.sun_path, path.c_str(), sizeof(addr.sun_path) - 1);
-        if (fd_ < 0 || ::connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) {
-            const std::string why = std::strerror(errno);
-            if (fd_ >= 0) ::close(fd_);
-            throw InputError(path + ": cannot connect to lipsyncd (" + why +
-                             "); is it running? (--socket)");
-        }
-    }
-    ~ControlConnection() { ::close(fd_); }
-    ControlConnection(const ControlConnection&) = delete;
-    ControlConnection& operator=(const ControlConnection&) = delete;
-
-    void send(const nlohmann::json& request) {
-        const auto line = request.dump() + "\n";
-        if (::send(fd_, line.data(), line.size(), MSG_NOSIGNAL) !=
-            static_cast<ssize_t>(line.size()))
-            throw std::runtime_error("control socket: write failed");
-    }
-    std::string readLine() {
-        for (;;) {
-            const auto nl = buffer_.find('\n');
-            if (nl != std::string::npos) {
-                auto line = buffer_.substr(0, nl);
-                buffer_.erase(0, nl + 1);
-                return line;
-            }
-            char buf[4096];
-            const auto n = ::read(fd_, buf, sizeof buf);
-            if (n <= 0) throw std::runtime_error("control socket: lipsyncd closed the connection");
-            buffer_.append(buf, static_cast<std::size_t>(n));
-        }
-    }
-
-  private:
-    int fd_ = -1;
-    std::string buffer_;
-};
+using daemon::ControlArg;
 
 struct CtlOptions {
     std::string socket = "/run/lipsyncd/control.sock";
@@ -66,52 +20,75 @@ struct CtlOptions {
     int channel = -1;
     std::string voice;
     bool wait = false;
+    double timeout = 5;
 };
+
+std::string usage() {
+    std::string u = "commands:";
+    for (const auto& c : daemon::controlCommands()) u += "\n  " + std::string(c.usage);
+    return u + "\n  raw JSON: send a request as it is";
+}
+
+// One command-line word as the argument's JSON value.
+nlohmann::json valueOf(const ControlArg& arg, const std::string& word) {
+    switch (arg.type) {
+        case ControlArg::Type::Boolean:
+            if (word == "on" || word == "true") return true;
+            if (word == "off" || word == "false") return false;
+            break;
+        case ControlArg::Type::Integer:
+            try {
+                return std::stol(word);
+            } catch (const std::exception&) {
+            }
+            break;
+        case ControlArg::Type::Path:
+            return std::filesystem::absolute(word).string();
+        case ControlArg::Type::String:
+            return word;
+    }
+    throw CLI::ValidationError("ctl", "'" + word + "' is not " + std::string(arg.help));
+}
 
 nlohmann::json requestFrom(const CtlOptions& o) {
     const auto& a = o.args;
-    const std::string cmd = a.front();
-    auto need = [&](std::size_t n, const char* usage) {
-        if (a.size() != n)
-            throw CLI::ValidationError("ctl", std::string("usage: lipsync ctl ") + usage);
-    };
-    if (cmd == "play") {
-        need(2, "play FILE");
-        nlohmann::json r = {{"cmd", "play"}, {"file", std::filesystem::absolute(a[1]).string()}};
-        if (o.channel >= 0) r["channel"] = o.channel;
+    if (a.front() == "raw") {
+        if (a.size() != 2) throw CLI::ValidationError("ctl", "usage: lipsync ctl raw '{...}'");
+        auto r = nlohmann::json::parse(a[1], nullptr, false);
+        if (r.is_discarded()) throw CLI::ValidationError("ctl", "raw: not JSON: " + a[1]);
         return r;
     }
-    if (cmd == "say") {
-        if (a.size() < 2) throw CLI::ValidationError("ctl", "usage: lipsync ctl say TEXT...");
-        std::string text;
-        for (std::size_t i = 1; i < a.size(); ++i) text += (i > 1 ? " " : "") + a[i];
-        nlohmann::json r = {{"cmd", "say"}, {"text", text}};
-        if (!o.voice.empty()) r["voice"] = o.voice;
-        return r;
+    const auto* command = daemon::findControlCommand(a.front());
+    if (!command)
+        throw CLI::ValidationError("ctl", "unknown command '" + a.front() + "'\n" + usage());
+    nlohmann::json r = {{"cmd", a.front()}};
+    if (!command->positional.empty() && a.size() > 1) {
+        const auto& arg =
+            *std::find_if(command->args.begin(), command->args.end(),
+                          [&](const ControlArg& x) { return x.name == command->positional; });
+        if (arg.type == ControlArg::Type::String) {  // words join into one text
+            std::string text;
+            for (std::size_t i = 1; i < a.size(); ++i) text += (i > 1 ? " " : "") + a[i];
+            r[arg.name] = text;
+        } else if (a.size() == 2) {
+            r[arg.name] = valueOf(arg, a[1]);
+        } else {
+            throw CLI::ValidationError("ctl", "usage: lipsync ctl " + std::string(command->usage));
+        }
+    } else if (a.size() > 1) {
+        throw CLI::ValidationError("ctl", "usage: lipsync ctl " + std::string(command->usage));
     }
-    if (cmd == "live") {
-        need(2, "live on|off");
-        return {{"cmd", "live"}, {"on", a[1] == "on"}};
-    }
-    if (cmd == "stop" || cmd == "status" || cmd == "queue" || cmd == "reload" ||
-        cmd == "subscribe") {
-        need(1, cmd.c_str());
-        return {{"cmd", cmd}};
-    }
-    if (cmd == "raw") {
-        need(2, "raw '{\"cmd\": ...}'");
-        return nlohmann::json::parse(a[1]);
-    }
-    throw CLI::ValidationError(
-        "ctl", "unknown command '" + cmd +
-                   "' (play, say, stop, queue, status, live, reload, subscribe, raw)");
+    if (o.channel >= 0 && command->name == "play") r["channel"] = o.channel;
+    if (!o.voice.empty() && command->name == "say") r["voice"] = o.voice;
+    if (const auto bad = daemon::checkControlRequest(r)) throw CLI::ValidationError("ctl", *bad);
+    return r;
 }
 
 void runCtl(const CtlOptions& o) {
     const auto request = requestFrom(o);
-    ControlConnection c(o.socket);
-    c.send(request);
-    const auto reply = nlohmann::json::parse(c.readLine());
+    daemon::ControlClient c(o.socket,
+                            std::chrono::milliseconds(static_cast<long>(o.timeout * 1000)));
+    const auto reply = c.request(request);
     std::cout << reply.dump() << std::endl;
     if (!reply.value("ok", false))
         throw std::runtime_error("lipsyncd: " +
@@ -121,8 +98,7 @@ void runCtl(const CtlOptions& o) {
     // --wait: until nothing plays or is queued.
     while (o.wait) {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        c.send({{"cmd", "status"}});
-        const auto s = nlohmann::json::parse(c.readLine());
+        const auto s = c.request({{"cmd", "status"}});
         if (s["playing"].is_null() && s["queue"].empty()) break;
     }
 }
@@ -130,13 +106,15 @@ void runCtl(const CtlOptions& o) {
 
 void addCtlCommand(CLI::App& app) {
     auto o = std::make_shared<CtlOptions>();
-    auto* cmd =
-        app.add_subcommand("ctl",
-                           "Talk to a running lipsyncd: play FILE, say TEXT, stop, queue, status, "
-                           "live on|off, reload, subscribe, raw JSON");
+    auto* cmd = app.add_subcommand(
+        "ctl", "Talk to a running lipsyncd: " + daemon::controlCommandNames() + ", raw JSON");
+    cmd->footer(usage());
     cmd->add_option("--socket", o->socket, "lipsyncd's control socket")->capture_default_str();
     cmd->add_option("--channel", o->channel, "play: analyse only this channel of the file");
     cmd->add_option("--voice", o->voice, "say: espeak-ng voice");
+    cmd->add_option("--timeout", o->timeout, "Seconds to wait for the daemon at each step")
+        ->capture_default_str()
+        ->check(CLI::Range(0.05, 3600.0));
     cmd->add_flag("--wait", o->wait, "Return when nothing plays or is queued any more");
     cmd->add_option("request", o->args, "The request and its arguments")->required();
     cmd->callback([o] { runCtl(*o); });

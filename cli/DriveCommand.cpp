@@ -52,7 +52,10 @@ void runDrive(const DriveOptions& o) {
     std::signal(SIGTERM, onStopSignal);
     const auto start = std::chrono::steady_clock::now();
     const auto waitUntil = [&](double t) {
-        if (o.realtime) std::this_thread::sleep_until(start + std::chrono::duration<double>(t));
+        // The puppet's lead: each frame goes out that much before its time (servo lag).
+        if (o.realtime)
+            std::this_thread::sleep_until(start +
+                                          std::chrono::duration<double>(t - puppet.leadSeconds));
     };
     double t = 0;
     bool stalled = false;

@@ -2,39 +2,19 @@
 // The first byte chooses how the rest is read: even, as a file whose type libsndfile detects
 // (WAV, FLAC, OGG, ...); odd, as raw PCM whose format, channels and rate the next three bytes
 // pick. A clean InputError or runtime_error is a correct answer; anything else is a bug.
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include <array>
 #include <cstdint>
 #include <cstdio>
 #include <lipsyncd/dsp.hpp>
 #include <string>
 
+#include "MemoryFile.hpp"
+
 namespace {
 
 using namespace lipsyncd;
 
-// The bytes as a file the decoder can open by path, without touching the disk.
-class MemoryFile {
-  public:
-    MemoryFile(const std::uint8_t* data, std::size_t size) : fd_(::memfd_create("fuzz", 0)) {
-        if (fd_ >= 0 && size > 0 && ::write(fd_, data, size) != static_cast<ssize_t>(size)) {
-            ::close(fd_);
-            fd_ = -1;
-        }
-    }
-    ~MemoryFile() {
-        if (fd_ >= 0) ::close(fd_);
-    }
-    MemoryFile(const MemoryFile&) = delete;
-    MemoryFile& operator=(const MemoryFile&) = delete;
-    bool ok() const { return fd_ >= 0; }
-    std::string path() const { return "/proc/self/fd/" + std::to_string(fd_); }
-
-  private:
-    int fd_;
-};
+using fuzz::MemoryFile;
 
 std::optional<dsp::RawFormat> rawFormatFrom(const std::uint8_t* header) {
     static constexpr std::array formats{"s8", "u8", "s16", "s24", "s32", "f32", "f64"};

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Measures the running daemon: CPU and memory while it plays the bundled example ten times (null
-# audio device, terminal puppet, no hardware), and then while idle. Prints one line per phase.
+# audio device, terminal puppet, no hardware), then idle, then live (the bundled example as the
+# microphone). Prints one line per phase, and the status (latency) while playing.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 tmp="$(mktemp -d)"; trap 'kill $pid 2>/dev/null || true; rm -rf "$tmp"' EXIT
@@ -12,6 +13,10 @@ puppet = "terminal"
 hardware = false
 [control]
 socket = "$tmp/control.sock"
+[limits]
+max_queue = 16
+[live]
+device = "file:$here/config/examples/hello.wav"
 TOML
 LIPSYNCD_DATA_DIR="$here/config" "$here/build/daemon/lipsyncd" --config "$tmp/lipsyncd.toml" 2>/dev/null &
 pid=$!
@@ -26,6 +31,11 @@ phase() {  # name seconds
   echo "$1: CPU $(echo "scale=2; 100 * ($c1 - $c0) / $hz / ($t1 - $t0)" | bc) % of a core, RSS $(rss) KiB"
 }
 echo "started: RSS $(rss) KiB"
+"$here/build/cli/lipsync" ctl --socket "$tmp/control.sock" status
 for _ in $(seq 10); do "$here/build/cli/lipsync" ctl --socket "$tmp/control.sock" play "$here/config/examples/hello.wav" >/dev/null; done
 phase "playing (10 x hello.wav queued)" 20
+"$here/build/cli/lipsync" ctl --socket "$tmp/control.sock" status
 phase "idle" 5
+"$here/build/cli/lipsync" ctl --socket "$tmp/control.sock" live on >/dev/null
+phase "live (hello.wav as the microphone, real-time pace)" 4
+"$here/build/cli/lipsync" ctl --socket "$tmp/control.sock" live off >/dev/null

@@ -39,6 +39,11 @@ std::vector<std::string_view> splitCsv(std::string_view line) {
     }
 }
 
+// What a file may hold: times within a day (anything that steps through the track would
+// otherwise run for ever), weights finite within ±kMaxWeight (they are 0 .. 1 by design).
+constexpr double kMaxSeconds = 86400;
+constexpr double kMaxWeight = 10;
+
 double parseNumber(std::string_view text, const std::string& source, std::size_t line,
                    const std::string& column) {
     double v = 0;
@@ -77,14 +82,19 @@ PoseTrack readPoseTrackCsv(std::istream& in, const std::string& sourceName) {
                              "expected " + std::to_string(header.size()) + " columns, found " +
                                  std::to_string(fields.size()));
         const double t = parseNumber(fields[0], sourceName, lineNo, "time");
-        if (!std::isfinite(t) || t < 0)
-            throw InputError(sourceName, lineNo, "time must be a finite, non-negative number");
+        if (!std::isfinite(t) || t < 0 || t > kMaxSeconds)
+            throw InputError(sourceName, lineNo, "time must be finite, within 0 .. 86400 s");
         if (!track.times.empty() && t <= track.times.back())
             throw InputError(sourceName, lineNo,
                              "time " + std::string(fields[0]) + " does not increase");
-        for (std::size_t p = 0; p < row.size(); ++p)
-            row[p] =
-                static_cast<float>(parseNumber(fields[p + 1], sourceName, lineNo, track.poses[p]));
+        for (std::size_t p = 0; p < row.size(); ++p) {
+            const double w = parseNumber(fields[p + 1], sourceName, lineNo, track.poses[p]);
+            if (!(std::abs(w) <= kMaxWeight))  // NaN too
+                throw InputError(sourceName, lineNo,
+                                 "column '" + track.poses[p] + "': " + std::string(fields[p + 1]) +
+                                     " is not a finite weight within -10 .. 10");
+            row[p] = static_cast<float>(w);
+        }
         track.append(t, row);
     }
     return track;

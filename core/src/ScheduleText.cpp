@@ -16,6 +16,9 @@ namespace {
 
 // Two segments closer than this (seconds) count as touching: labels are written in ms.
 constexpr double kTimeTolerance = 1e-4;
+// The longest schedule read (a day): beyond it a time is a typo or an attack, and every
+// consumer that steps through time (animate, drive) would run for ever or exhaust memory.
+constexpr double kMaxSeconds = 86400;
 
 std::vector<std::string_view> splitFields(std::string_view line) {
     std::vector<std::string_view> fields;
@@ -39,6 +42,9 @@ double parseTime(std::string_view text, const std::string& source, std::size_t l
     if (value < 0)
         throw InputError(source, line, std::string(column) + " time " + std::string(text) +
                                            " is negative");
+    if (value > kMaxSeconds)
+        throw InputError(source, line, std::string(column) + " time " + std::string(text) +
+                                           " is beyond 86400 s (a day)");
     return value;
 }
 

@@ -1,6 +1,7 @@
 // Requests made ready to play: a file is decoded and analysed offline (ahead of playback, so a
 // replayed file has no recognition latency); text is spoken by espeak-ng with its exact
 // schedule. Either way the pose weights are computed before the first sample is heard.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <lipsyncd/daemon.hpp>
@@ -45,20 +46,40 @@ const std::vector<std::string>& ClipMaker::poseNames() const {
     return impl_->poseNames;
 }
 
+namespace {
+// The sound to play, decoded a block at a time straight into 16-bit samples: no float copy
+// of the whole file is ever held (memory with a full queue of long clips).
+std::vector<std::int16_t> decodeForPlayback(const std::filesystem::path& file,
+                                            const dsp::DecodeOptions& options, int& rate) {
+    auto decoder = dsp::AudioDecoder::open(file, options);
+    rate = decoder.sampleRate();
+    std::vector<std::int16_t> out;
+    out.reserve(static_cast<std::size_t>(decoder.frames().value_or(0)));
+    std::array<float, 4096> block{};
+    while (const auto n = decoder.read(block))
+        for (std::size_t i = 0; i < n; ++i)
+            out.push_back(static_cast<std::int16_t>(
+                std::lround(std::clamp(block[i], -1.0f, 1.0f) * 32767.0f)));
+    return out;
+}
+}  // namespace
+
 Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
     dsp::DecodeOptions decode;
     decode.channel = channel;
     Clip clip;
     clip.name = file.string();
-    // Analysed on `channel` (the voice), played on the others (what the audience hears).
+    // Analysed on `channel` (the voice), played on the others (what the audience hears); the
+    // analysis first, so its buffers are gone before the sound's is made.
+    const auto result = dsp::analyzeFile(file, impl_->templates, PhonemeSet::common(), {}, decode);
+    {
+        // The mouth opens as wide as the voice is loud: its samples, gone before the sound's.
+        const auto voice = dsp::readAudioFile(file, decode);
+        clip.weights = impl_->animate(result.schedule, voice.samples, voice.sampleRate);
+    }
     dsp::DecodeOptions play;
     play.skipChannel = channel;
-    const auto audio = dsp::readAudioFile(file, play);
-    clip.samples = audio.samples;
-    clip.rate = audio.sampleRate;
-    const auto result = dsp::analyzeFile(file, impl_->templates, PhonemeSet::common(), {}, decode);
-    const auto voice = channel >= 0 ? dsp::readAudioFile(file, decode) : audio;
-    clip.weights = impl_->animate(result.schedule, voice.samples, voice.sampleRate);
+    clip.samples = decodeForPlayback(file, play, clip.rate);
     return clip;
 }
 
@@ -69,9 +90,12 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
     Clip clip;
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;
-    for (auto s : speech.samples) clip.samples.push_back(static_cast<float>(s) / 32768.0f);
+    clip.samples = speech.samples;
+    std::vector<float> level(speech.samples.size());  // for its loudness, then gone
+    std::transform(speech.samples.begin(), speech.samples.end(), level.begin(),
+                   [](std::int16_t x) { return static_cast<float>(x) / 32768.0f; });
     clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr),
-                                  clip.samples, clip.rate);
+                                  level, clip.rate);
     return clip;
 }
 

@@ -1,4 +1,5 @@
 // lipsyncd.toml, read strictly (TomlTable): a typo stops start-up with the file, line and key.
+#include <cmath>
 #include <lipsyncd/daemon.hpp>
 #include <lipsyncd/toml_table.hpp>
 
@@ -10,6 +11,14 @@ double seconds(const TomlTable& t, const std::string& key, double fallback, doub
     if (!(v >= lo && v <= hi))
         t.fail(key, "must be within " + std::to_string(lo) + " .. " + std::to_string(hi) + " s");
     return v;
+}
+std::size_t count(const TomlTable& t, const std::string& key, std::size_t fallback, std::size_t lo,
+                  std::size_t hi) {
+    const double v = t.optNumber(key).value_or(static_cast<double>(fallback));
+    if (!(v >= static_cast<double>(lo) && v <= static_cast<double>(hi) && v == std::floor(v)))
+        t.fail(key,
+               "must be a whole number within " + std::to_string(lo) + " .. " + std::to_string(hi));
+    return static_cast<std::size_t>(v);
 }
 }  // namespace
 
@@ -31,7 +40,8 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
             mouth->fail("runtime", "must be \"bigram\" or \"filter\"");
         c.templates = mouth->optString("templates").value_or("");
         c.voice = mouth->optString("voice").value_or(c.voice);
-        c.leadSeconds = seconds(*mouth, "lead", c.leadSeconds, -1, 1);
+        if (mouth->optNumber("lead"))
+            mouth->fail("lead", "belongs to the puppet file now (lead = SECONDS: its servo lag)");
         c.syncOffsetSeconds = seconds(*mouth, "sync_offset", 0, -2, 2);
         c.hardware = mouth->optBool("hardware").value_or(true);
         c.record = mouth->optString("record").value_or("");
@@ -59,7 +69,14 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         } catch (const std::exception&) {
             control->fail("mode", "must be an octal file mode such as \"0660\"");
         }
+        c.maxClients = count(*control, "max_clients", c.maxClients, 1, 1000);
         control->finish();
+    }
+    if (const auto limits = root.optTable("limits")) {
+        c.maxClipSeconds = seconds(*limits, "max_clip_seconds", c.maxClipSeconds, 0.1, 3600);
+        c.maxTextBytes = count(*limits, "max_text_bytes", c.maxTextBytes, 1, 16384);
+        c.maxQueue = count(*limits, "max_queue", c.maxQueue, 1, 1000);
+        limits->finish();
     }
     root.finish();
     return c;

@@ -1,4 +1,5 @@
 // lipsyncd: the service. `lipsyncd --config FILE` (default /etc/lipsyncd/lipsyncd.toml).
+#include <malloc.h>
 #include <systemd/sd-daemon.h>
 
 #include <CLI/CLI.hpp>
@@ -6,6 +7,11 @@
 #include <lipsyncd/daemon.hpp>
 
 int main(int argc, char** argv) {
+    // Clip buffers are megabytes, made on the worker and freed when played: a fixed mmap
+    // threshold gives every one back to the system when freed (glibc's adaptive threshold
+    // would keep them in the arenas), and one arena per thread is plenty.
+    mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+    mallopt(M_ARENA_MAX, 2);
     CLI::App app{
         "lipsyncd: the lip-sync service. Plays speech and drives a puppet's mouth in sync;\n"
         "controlled over a Unix socket (see `lipsync ctl --help`). Runs under systemd\n"

@@ -1,6 +1,8 @@
 // Puppet files (config/puppets/*.toml), read strictly: unknown keys, wrong types, duplicate
 // GPIO lines, min > max, a rest outside the limits: each stops loading with the file and line.
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <iomanip>
 #include <lipsyncd/output.hpp>
 #include <lipsyncd/toml_table.hpp>
@@ -64,6 +66,28 @@ void readBackendSettings(const TomlTable& t, ActuatorConfig& a) {
     }
 }
 
+// Values a puppet file may hold (NaN and inf would pass every later comparison): finite
+// within ±1e6; names plain enough for the command record's CSV and the terminal.
+void checkActuatorBounds(const TomlTable& t, const ActuatorConfig& a) {
+    constexpr double kLimit = 1e6;
+    const auto bounded = [&](const char* key, double v) {
+        if (!(std::abs(v) <= kLimit)) t.fail(key, "must be a finite number within -1e6 .. 1e6");
+    };
+    bounded("neutral", a.neutral);
+    bounded("trim", a.trim);
+    bounded("min", a.min);
+    bounded("max", a.max);
+    for (const auto& [pose, gain] : a.gains)
+        if (!(std::abs(gain) <= kLimit))
+            t.fail("gains", "gain for '" + pose + "' must be a finite number within -1e6 .. 1e6");
+    const bool plain =
+        !a.name.empty() && a.name.size() <= 64 &&
+        std::all_of(a.name.begin(), a.name.end(), [](char c) {
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+        });
+    if (!plain) t.fail("name", "must be 1 to 64 letters, digits, '_', '-' or '.'");
+}
+
 ActuatorConfig readActuator(const TomlTable& t) {
     ActuatorConfig a;
     a.line = t.line();
@@ -79,6 +103,7 @@ ActuatorConfig readActuator(const TomlTable& t) {
     a.invert = t.optBool("invert").value_or(false);
     a.min = t.getNumber("min");
     a.max = t.getNumber("max");
+    checkActuatorBounds(t, a);
     if (!(a.min < a.max)) t.fail("max", "must be greater than min");
     a.rest = t.optNumber("rest").value_or(a.min);
     if (!(a.rest >= a.min && a.rest <= a.max)) t.fail("rest", "must be within min .. max");
@@ -155,6 +180,7 @@ Puppet Puppet::load(const std::filesystem::path& file) {
     p.name = root.getString("name");
     p.description = root.optString("description").value_or("");
     p.stallTimeout = number(root, "stall_timeout", 0.5, 0.01, 3600);
+    p.leadSeconds = number(root, "lead", 0, 0, 1);
     for (const auto& h : root.tableArray("hid")) p.hidDevices.push_back(readHid(h));
     for (const auto& t : root.tableArray("actuator")) p.actuators.push_back(readActuator(t));
     root.finish();

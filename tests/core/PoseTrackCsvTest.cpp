@@ -33,11 +33,13 @@ TEST(PoseTrackCsv, RoundTrips) {
     EXPECT_EQ(back.pose("pbm"), 1u);
 }
 
-TEST(PoseTrackCsv, KeepsNonFiniteValuesForTheOutputStageToHandle) {
-    std::istringstream in("time,open\n0,nan\n0.01,inf\n");
-    const auto t = readPoseTrackCsv(in, "w.csv");
-    EXPECT_TRUE(std::isnan(t.values[0]));
-    EXPECT_TRUE(std::isinf(t.values[1]));
+TEST(PoseTrackCsv, RefusesNonFiniteAndOutOfRangeValuesAndTimesWithTheLine) {
+    EXPECT_NE(errorOf("time,open\n0,nan\n").find("w.csv:2:"), std::string::npos);
+    EXPECT_NE(errorOf("time,open\n0,0\n0.01,inf\n").find("w.csv:3:"), std::string::npos);
+    EXPECT_NE(errorOf("time,open\n0,-inf\n").find("'open'"), std::string::npos);
+    EXPECT_NE(errorOf("time,open\n0,1e300\n").find("w.csv:2:"), std::string::npos);
+    EXPECT_NE(errorOf("time,open\n0,0\n1e300,0\n").find("w.csv:3:"), std::string::npos);
+    EXPECT_NE(errorOf("time,open\n0,0\n1e7,0\n").find("86400"), std::string::npos);
 }
 
 TEST(PoseTrackCsv, ErrorsNameLineAndColumn) {

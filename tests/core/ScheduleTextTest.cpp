@@ -89,3 +89,9 @@ TEST(ScheduleText, UnknownPhonemesWarnOrFail) {
     strict.unknownIsError = true;
     EXPECT_NE(errorOf("0 0.1 zork\n", strict).find("'zork'"), std::string::npos);
 }
+
+TEST(ScheduleText, TimesBeyondADayAreRefusedWithTheLine) {
+    EXPECT_NE(errorOf("0 0.1 sil\n0.1 1e7 aa\n").find("test.tsv:2:"), std::string::npos);
+    EXPECT_NE(errorOf("0 1e300 aa\n").find("86400"), std::string::npos);
+    EXPECT_NE(errorOf("0 0.1 aa 1e300\n").find("test.tsv:1:"), std::string::npos);
+}

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "../cli/RunLipsync.hpp"
+#include "DaemonProcess.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -24,151 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace std::chrono_literals;
-
-// A datagram socket standing in for systemd's notification socket.
-class NotifySocket {
-  public:
-    explicit NotifySocket(const fs::path& path) : path_(path) {
-        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-        sockaddr_un a{};
-        a.sun_family = AF_UNIX;
-        std::strncpy(a.sun_path, path.c_str(), sizeof(a.sun_path) - 1);
-        ::unlink(path.c_str());
-        EXPECT_EQ(::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-        timeval tv{0, 200'000};
-        ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    }
-    ~NotifySocket() { ::close(fd_); }
-    // Waits up to `timeout` for a message containing `what`; returns everything received.
-    bool waitFor(const std::string& what, std::chrono::milliseconds timeout = 10s) {
-        const auto end = std::chrono::steady_clock::now() + timeout;
-        while (std::chrono::steady_clock::now() < end) {
-            char buf[4096];
-            const auto n = ::recv(fd_, buf, sizeof buf, 0);
-            if (n > 0) received.emplace_back(buf, static_cast<std::size_t>(n));
-            for (const auto& m : received)
-                if (m.find(what) != std::string::npos) return true;
-        }
-        return false;
-    }
-    std::vector<std::string> received;
-
-  private:
-    fs::path path_;
-    int fd_;
-};
-
-class Client {
-  public:
-    explicit Client(const fs::path& path) {
-        for (int i = 0; i < 100 && fd_ < 0; ++i) {
-            fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-            sockaddr_un a{};
-            a.sun_family = AF_UNIX;
-            std::strncpy(a.sun_path, path.c_str(), sizeof(a.sun_path) - 1);
-            if (::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) break;
-            ::close(fd_);
-            fd_ = -1;
-            std::this_thread::sleep_for(50ms);
-        }
-    }
-    ~Client() {
-        if (fd_ >= 0) ::close(fd_);
-    }
-    bool connected() const { return fd_ >= 0; }
-    void sendLine(const std::string& line) {
-        ::send(fd_, (line + "\n").data(), line.size() + 1, MSG_NOSIGNAL);
-    }
-    std::string readLine() {
-        for (;;) {
-            const auto nl = buf_.find('\n');
-            if (nl != std::string::npos) {
-                auto l = buf_.substr(0, nl);
-                buf_.erase(0, nl + 1);
-                return l;
-            }
-            char b[4096];
-            const auto n = ::read(fd_, b, sizeof b);
-            if (n <= 0) return "";
-            buf_.append(b, static_cast<std::size_t>(n));
-        }
-    }
-    json request(const json& r) {
-        sendLine(r.dump());
-        return json::parse(readLine());
-    }
-
-  private:
-    int fd_ = -1;
-    std::string buf_;
-};
-
-struct DaemonProcess {
-    fs::path dir = scratchDir("daemon");
-    pid_t pid = -1;
-
-    explicit DaemonProcess(const std::string& extraMouth = "", const std::string& device = "null") {
-        std::ofstream(dir / "lipsyncd.toml")
-            << "[audio]\ndevice = \"" << device << "\"\n[mouth]\npuppet = \"terminal\"\n"
-            << "hardware = false\nrecord = \"" << (dir / "rec.csv").string() << "\"\n"
-            << extraMouth << "[control]\nsocket = \"" << (dir / "control.sock").string() << "\"\n";
-    }
-    void start() {
-        ::setenv("NOTIFY_SOCKET", (dir / "notify").c_str(), 1);
-        std::vector<std::string> args{LIPSYNCD_DAEMON_BIN, "--config",
-                                      (dir / "lipsyncd.toml").string()};
-        std::vector<char*> argv;
-        for (auto& a : args) argv.push_back(a.data());
-        argv.push_back(nullptr);
-        posix_spawn_file_actions_t actions;
-        posix_spawn_file_actions_init(&actions);
-        posix_spawn_file_actions_addopen(&actions, 2, (dir / "stderr.log").c_str(),
-                                         O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
-        posix_spawn_file_actions_destroy(&actions);
-        ::unsetenv("NOTIFY_SOCKET");
-    }
-    int stop(int signal = SIGTERM) {
-        ::kill(pid, signal);
-        int status = 0;
-        ::waitpid(pid, &status, 0);
-        pid = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    }
-    ~DaemonProcess() {
-        if (pid > 0) stop(SIGKILL);
-    }
-    long rssKiB() const {
-        std::ifstream s("/proc/" + std::to_string(pid) + "/status");
-        for (std::string line; std::getline(s, line);)
-            if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-        return -1;
-    }
-    // (time, value) of one actuator from the recorder.
-    std::vector<std::pair<double, double>> recorded(const std::string& actuator) const {
-        std::ifstream in(dir / "rec.csv");
-        std::vector<std::pair<double, double>> out;
-        std::string line;
-        std::getline(in, line);
-        while (std::getline(in, line)) {
-            const auto a = line.find(','), b = line.find(',', a + 1), c = line.find(',', b + 1);
-            if (line.substr(a + 1, b - a - 1) == actuator)
-                out.emplace_back(std::stod(line.substr(0, a)),
-                                 std::stod(line.substr(b + 1, c - b - 1)));
-        }
-        return out;
-    }
-};
-
-void waitUntilIdle(Client& c, std::chrono::seconds timeout = 20s) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < end) {
-        const auto s = c.request({{"cmd", "status"}});
-        if (s["playing"].is_null() && s["queue"].empty()) return;
-        std::this_thread::sleep_for(50ms);
-    }
-    FAIL() << "still playing after " << timeout.count() << " s";
-}
 
 TEST(Daemon, NotifiesSystemdReloadsOnSighupAndRestsOnSigterm) {
     DaemonProcess d;
@@ -209,7 +64,7 @@ TEST(Daemon, MalformedConfigStopsStartupWithTheLine) {
 }
 
 TEST(Daemon, PlayedFileDrivesTheMouthAsTheOfflinePassDoes) {
-    DaemonProcess d("lead = 0.0\n", "file:" + (scratchDir("daemon_audio") / "out.wav").string());
+    DaemonProcess d("", "file:" + (scratchDir("daemon_audio") / "out.wav").string());
     d.start();
     Client c(d.dir / "control.sock");
     ASSERT_TRUE(c.connected());

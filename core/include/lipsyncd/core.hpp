@@ -143,8 +143,9 @@ struct ScheduleReadOptions {
 };
 
 // Reads TSV / .lab text: `start end phoneme [confidence]` separated by tabs or spaces, '#'
-// comments and blank lines allowed. Checks times (finite, non-negative, end > start, sorted,
-// no overlaps) and phonemes; errors name `sourceName` and the line. Warnings go to `warnings`.
+// comments and blank lines allowed. Checks times (finite, within 0 .. 86400 s, end > start,
+// sorted, no overlaps) and phonemes; errors name `sourceName` and the line. Warnings go to
+// `warnings`.
 PhonemeSchedule readSchedule(std::istream& in, const std::string& sourceName,
                              const ScheduleReadOptions& options = {},
                              std::vector<std::string>* warnings = nullptr);
@@ -188,9 +189,9 @@ struct PoseTrack {
     void append(double time, std::span<const float> weights);  // weights.size() == poses.size()
 };
 
-// CSV with header `time,<pose>,<pose>,...`. Times must be finite and increasing; values may be
-// non-finite ("nan", "inf": the actuator stage holds the last good value) and are otherwise
-// taken as they are (the actuator stage clamps). Errors name the line and column.
+// CSV with header `time,<pose>,<pose>,...`. Times must be finite, within 0 .. 86400 s and
+// increasing; values finite within -10 .. 10 (the actuator stage clamps further). Errors name
+// the line and column.
 PoseTrack readPoseTrackCsv(std::istream& in, const std::string& sourceName);
 PoseTrack readPoseTrackCsvFile(const std::filesystem::path& file);  // "-" is stdin
 void writePoseTrackCsv(std::ostream& out, const PoseTrack& track);

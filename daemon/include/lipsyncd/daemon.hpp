@@ -10,10 +10,13 @@
 //   Player         the queue: plays clips one after another through the sink and drives the
 //                  puppet at the sink's clock plus the puppet's lead time and the sync offset.
 //   ControlServer  a Unix socket speaking JSON lines to many clients at once.
+//   ControlCommand the protocol's one command table (names, argument types, limits), shared
+//                  by the daemon, `lipsync ctl` and the tests; ControlClient is their client.
 //   Daemon         all of it in one poll() loop with sd_notify (READY, STATUS, WATCHDOG,
 //                  RELOADING, STOPPING), SIGHUP reload and SIGTERM rest-then-exit.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
@@ -24,6 +27,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace lipsyncd {
@@ -44,7 +48,7 @@ struct DaemonConfig {
     std::string runtime = "bigram";  // bigram | filter
     std::string templates;           // empty: the shipped default
     std::string voice = "en-us";
-    double leadSeconds = 0.05;     // drive the mouth this much ahead of the sound (servo lag)
+    // (The lead that makes up for servo lag belongs to the puppet file: Puppet::leadSeconds.)
     double syncOffsetSeconds = 0;  // the user's correction, + moves the mouth later
     bool hardware = true;          // open the puppet's GPIO/HID outputs
     std::string record;            // also record every actuator command here (CSV)
@@ -55,10 +59,66 @@ struct DaemonConfig {
     // [control]
     std::filesystem::path socket = "/run/lipsyncd/control.sock";
     unsigned socketMode = 0660;
+    std::size_t maxClients = 16;  // more get {"ok": false, "error": "too many clients"}
     double outputRateHz = 100;
+    // [limits]: what one request may cost (memory, the worker's time).
+    double maxClipSeconds = 30;
+    std::size_t maxTextBytes = 600;
+    std::size_t maxQueue = 8;
 
     static DaemonConfig load(const std::filesystem::path& file);  // InputError with file:line
 };
+
+// ---------------------------------------------------------------------------------------------
+// The control protocol: one JSON object per line, {"cmd": NAME, ARG: value, ...}; one reply per
+// request, {"ok": true, ...} or {"ok": false, "error": "..."}.
+
+struct ControlArg {
+    enum class Type { String, Path, Boolean, Integer };  // Path: a string the client makes absolute
+    std::string_view name;
+    Type type;
+    bool required;
+    std::size_t maxLength;  // strings: bytes
+    long min, max;          // integers
+    std::string_view help;
+};
+
+struct ControlCommand {
+    std::string_view name;
+    std::string_view usage;       // "play FILE: queue an audio file"
+    std::string_view positional;  // the argument `lipsync ctl NAME WORDS...` fills, or ""
+    std::span<const ControlArg> args;
+};
+
+std::span<const ControlCommand> controlCommands();
+const ControlCommand* findControlCommand(std::string_view name);  // nullptr when unknown
+std::string controlCommandNames();                                // "live, play, ..."
+// nullopt when `request` fits the table; otherwise why not, naming the command and argument.
+std::optional<std::string> checkControlRequest(const nlohmann::json& request);
+
+// A client of the control socket with a deadline on every step (connect, write, each reply):
+// a daemon that does not answer is an error, never a hang.
+class ControlClient {
+  public:
+    // InputError naming the socket when nothing listens there.
+    ControlClient(const std::filesystem::path& socket, std::chrono::milliseconds timeout);
+    ~ControlClient();
+    ControlClient(const ControlClient&) = delete;
+    ControlClient& operator=(const ControlClient&) = delete;
+
+    nlohmann::json request(const nlohmann::json& request);  // send, then the next reply
+    void sendRaw(std::string_view bytes);                   // any bytes (tests send bad ones)
+    std::string readLine();  // the next line; std::runtime_error on timeout or a closed socket
+
+  private:
+    void waitFor(short events, const char* what) const;
+    int fd_ = -1;
+    std::chrono::milliseconds timeout_;
+    std::string buffer_;
+    std::filesystem::path socket_;
+};
+
+// ---------------------------------------------------------------------------------------------
 
 class AudioSink {
   public:
@@ -85,7 +145,7 @@ std::unique_ptr<CaptureSource> openCaptureSource(const std::string& device, int 
 
 struct Clip {
     std::string name;
-    std::vector<float> samples;  // mono
+    std::vector<std::int16_t> samples;  // mono, 16-bit: half a float's memory (max_queue)
     int rate = 0;
     PoseTrack weights;
 };
@@ -125,6 +185,11 @@ class Daemon {
     int run();
     // One JSON request, one JSON reply (the socket's protocol; public for tests).
     nlohmann::json handle(const nlohmann::json& request);
+    // The socket's protocol without the socket (fuzzing, tests): one request line in, the
+    // reply line out, through the same checks a connection's lines go through.
+    std::string answer(const std::string& line);
+    // One pass of the loop's work without its timer: a tick, and failures reported.
+    void tickOnce();
 
   private:
     struct Impl;

@@ -127,6 +127,7 @@ struct Puppet {
     std::string name, description;
     std::filesystem::path source;
     double stallTimeout = 0.5;  // seconds without input before the mouth goes to rest
+    double leadSeconds = 0;     // the mouth is driven this much ahead of the sound (servo lag)
     std::vector<ActuatorConfig> actuators;
     std::vector<HidDeviceConfig> hidDevices;
 

@@ -1,0 +1,55 @@
+// What a play or say request must be before it is queued (checked at once, in the request's
+// reply), and how the worker makes it ready. Bounded input: regular files only (a FIFO or a
+// device would block the worker for ever), clips no longer than the config allows, text no
+// longer than the config allows.
+#include <sndfile.h>
+#include <sys/stat.h>
+
+#include <lipsyncd/tts.hpp>
+
+#include "ClipQueue.hpp"
+
+namespace lipsyncd::daemon {
+
+double checkAudioFile(const std::filesystem::path& file, double maxSeconds) {
+    struct stat st {};
+    if (::stat(file.c_str(), &st) != 0) throw InputError(file.string() + ": no such file");
+    if (!S_ISREG(st.st_mode)) throw InputError(file.string() + ": not a regular file");
+    SF_INFO info{};
+    SNDFILE* f = sf_open(file.c_str(), SFM_READ, &info);  // reads the header only
+    if (!f) throw InputError(file.string() + ": not audio (" + sf_strerror(nullptr) + ")");
+    sf_close(f);
+    if (info.samplerate <= 0) throw InputError(file.string() + ": no sample rate");
+    const double seconds = static_cast<double>(info.frames) / info.samplerate;
+    if (seconds > maxSeconds)
+        throw InputError(file.string() + ": " + std::to_string(seconds) +
+                         " s is longer than max_clip_seconds (" + std::to_string(maxSeconds) +
+                         " s in the config)");
+    return seconds;
+}
+
+void checkText(const std::string& text, std::size_t maxBytes) {
+    if (text.size() > maxBytes)
+        throw InputError("say: " + std::to_string(text.size()) +
+                         " bytes of text is more than max_text_bytes (" + std::to_string(maxBytes) +
+                         " in the config)");
+}
+
+Clip prepareClip(const ClipRequest& request, std::unique_ptr<EspeakSynthesizer>& synth) {
+    Clip clip;
+    if (!request.file.empty()) {
+        checkAudioFile(request.file, request.maxSeconds);  // again: it may have changed since
+        // request.knownText: alignment (lipsync align) takes it here, when it exists.
+        clip = request.maker->fromFile(request.file, request.channel);
+    } else {
+        if (!synth) synth = std::make_unique<EspeakSynthesizer>();
+        clip = request.maker->fromText(*synth, request.text, request.voice);
+    }
+    const double seconds = static_cast<double>(clip.samples.size()) / clip.rate;
+    if (seconds > request.maxSeconds)
+        throw InputError(std::to_string(seconds) + " s is longer than max_clip_seconds");
+    clip.name = request.name;
+    return clip;
+}
+
+}  // namespace lipsyncd::daemon

@@ -1,0 +1,126 @@
+// The worker prepares only the front request: one clip ready ahead of the one that plays, so a
+// full queue of long clips costs their requests' few bytes, not their audio.
+#include "ClipQueue.hpp"
+
+#include <malloc.h>
+#include <pthread.h>
+
+#include <csignal>
+#include <functional>
+#include <lipsyncd/tts.hpp>
+#include <utility>
+
+namespace lipsyncd::daemon {
+
+namespace {
+// The worker takes no signals (it inherits the mask it starts with): SIGTERM and SIGHUP go to
+// the main loop's signalfd, never kill the process from under it.
+std::thread startWithoutSignals(std::function<void()> body) {
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &old);
+    std::thread t(std::move(body));
+    pthread_sigmask(SIG_SETMASK, &old, nullptr);
+    return t;
+}
+}  // namespace
+
+ClipQueue::ClipQueue(std::size_t capacity)
+    : capacity_(capacity), worker_(startWithoutSignals([this] { work(); })) {}
+
+ClipQueue::~ClipQueue() {
+    {
+        std::lock_guard lock(mutex_);
+        stopping_ = true;
+    }
+    wake_.notify_all();
+    worker_.join();
+}
+
+bool ClipQueue::push(ClipRequest request) {
+    {
+        std::lock_guard lock(mutex_);
+        if (jobs_.size() >= capacity_) return false;
+        jobs_.push_back({std::move(request), std::nullopt, false});
+    }
+    wake_.notify_all();
+    return true;
+}
+
+std::optional<Clip> ClipQueue::tryTakeReady() {
+    std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock || jobs_.empty() || !jobs_.front().clip) return std::nullopt;
+    auto clip = std::move(jobs_.front().clip);
+    jobs_.pop_front();
+    lock.unlock();
+    wake_.notify_all();  // the next one can be made now
+    return clip;
+}
+
+void ClipQueue::clear() {
+    std::lock_guard lock(mutex_);
+    jobs_.clear();
+    ++generation_;
+}
+
+void ClipQueue::setCapacity(std::size_t capacity) {
+    std::lock_guard lock(mutex_);
+    capacity_ = capacity;
+}
+
+std::size_t ClipQueue::capacity() const {
+    std::lock_guard lock(mutex_);
+    return capacity_;
+}
+
+std::vector<std::string> ClipQueue::names() const {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> out;
+    for (const auto& j : jobs_) out.push_back(j.request.name);
+    return out;
+}
+
+bool ClipQueue::empty() const {
+    std::lock_guard lock(mutex_);
+    return jobs_.empty();
+}
+
+std::vector<std::string> ClipQueue::takeFailures() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(failures_, {});
+}
+
+void ClipQueue::work() {
+    std::unique_ptr<EspeakSynthesizer> synth;  // this thread's, for the process's life
+    std::unique_lock lock(mutex_);
+    for (;;) {
+        wake_.wait(lock, [&] {
+            return stopping_ || (!jobs_.empty() && !jobs_.front().clip && !jobs_.front().preparing);
+        });
+        if (stopping_) return;
+        jobs_.front().preparing = true;
+        const auto request = jobs_.front().request;
+        const auto generation = generation_;
+        lock.unlock();
+        std::optional<Clip> clip;
+        std::string failure;
+        try {
+            clip = prepareClip(request, synth);
+        } catch (const std::exception& e) {
+            failure = request.name + ": " + e.what();
+        }
+        ::malloc_trim(0);  // the decoder's and analysis's buffers back to the system
+        lock.lock();
+        // clear() in the meantime: the front is another request now, or nothing.
+        if (generation != generation_ || jobs_.empty()) continue;
+        if (clip) {
+            jobs_.front().clip = std::move(clip);
+            jobs_.front().preparing = false;
+        } else {
+            failures_.push_back(std::move(failure));
+            jobs_.pop_front();
+        }
+    }
+}
+
+}  // namespace lipsyncd::daemon

@@ -1,0 +1,53 @@
+// The daemon's state and its parts, shared by the files that each do one job with it:
+// Daemon.cpp (the loop and signals), Requests.cpp (the control commands), Events.cpp (what
+// subscribers and status see), DaemonReload.cpp (SIGHUP).
+#pragma once
+
+#include <lipsyncd/daemon.hpp>
+#include <nlohmann/json.hpp>
+
+#include "ClipQueue.hpp"
+#include "ControlServer.hpp"
+#include "LiveMode.hpp"
+#include "Player.hpp"
+#include "Setup.hpp"
+
+namespace lipsyncd::daemon {
+
+void logInfo(const std::string& what);
+void logWarning(const std::string& what);
+void logError(const std::string& what);
+
+struct Daemon::Impl {
+    std::filesystem::path configFile;
+    std::unique_ptr<Setup> setup;
+    std::unique_ptr<ControlServer> control;
+    ClipQueue queue{8};
+    Player player;
+    std::optional<LiveMode> live;
+    double start = 0;
+    double lastEvent = 0, lastWatchdog = 0;
+    std::uint64_t watchdogUsec = 0;
+    std::size_t clipsPlayed = 0;
+
+    explicit Impl(std::filesystem::path file);
+    double now() const;
+    void status(const std::string& what);
+    void tick();
+    void restNow();  // the mouth to rest in real time (slew-limited steps, really waited for)
+    void reload();
+    void reportFailures();
+
+    // Requests.cpp
+    nlohmann::json handle(const nlohmann::json& request);
+    nlohmann::json play(const nlohmann::json& request);
+    nlohmann::json say(const nlohmann::json& request);
+    nlohmann::json stop();
+    nlohmann::json setLive(bool on);
+
+    // Events.cpp
+    nlohmann::json frameEvent(double t) const;
+    nlohmann::json statusReply() const;
+};
+
+}  // namespace lipsyncd::daemon

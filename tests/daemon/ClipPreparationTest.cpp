@@ -1,0 +1,133 @@
+// Requests are bounded before they are queued, prepared on the worker while the mouth goes on,
+// and a reload keeps what plays and what waits.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include "DaemonProcess.hpp"
+
+namespace lipsyncd::test {
+namespace {
+
+std::string errorOf(const json& reply) {
+    return reply.value("error", std::string());
+}
+
+TEST(ClipPreparation, AFifoIsRefusedAndTheLoopGoesOn) {
+    DaemonProcess d;
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    const auto fifo = d.dir / "pipe.wav";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const auto reply = c.request({{"cmd", "play"}, {"file", fifo.string()}});
+    EXPECT_EQ(reply["ok"], false);
+    EXPECT_NE(errorOf(reply).find("not a regular file"), std::string::npos) << reply;
+    EXPECT_TRUE(c.request({{"cmd", "status"}})["ok"]);
+    EXPECT_EQ(d.stop(), 0);
+}
+
+TEST(ClipPreparation, ClipsAndTextBeyondTheConfiguredLimitsAreRefused) {
+    DaemonProcess d;
+    d.append("[limits]\nmax_clip_seconds = 0.5\nmax_text_bytes = 100\n");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    const auto longFile =
+        c.request({{"cmd", "play"}, {"file", findDataFile("examples/hello.wav").string()}});
+    EXPECT_EQ(longFile["ok"], false);
+    EXPECT_NE(errorOf(longFile).find("max_clip_seconds"), std::string::npos) << longFile;
+    const auto longText = c.request({{"cmd", "say"}, {"text", std::string(101, 'a')}});
+    EXPECT_EQ(longText["ok"], false);
+    EXPECT_NE(errorOf(longText).find("max_text_bytes"), std::string::npos) << longText;
+    // Speech longer than the clip limit fails on the worker, said to subscribers; never plays.
+    Client watcher(d.socket());
+    ASSERT_TRUE(watcher.request({{"cmd", "subscribe"}})["ok"]);
+    ASSERT_TRUE(
+        c.request({{"cmd", "say"}, {"text", "This takes longer than half a second."}})["ok"]);
+    bool failed = false;
+    for (int i = 0; i < 200 && !failed; ++i) {
+        const auto line = json::parse(watcher.readLine(), nullptr, false);
+        failed = line.value("event", "") == "failed";
+        EXPECT_TRUE(line.value("weights", json::object()).empty()) << "it played: " << line;
+    }
+    EXPECT_TRUE(failed) << "no failed event";
+    EXPECT_EQ(d.stop(), 0);
+}
+
+TEST(ClipPreparation, TheQueueIsBounded) {
+    DaemonProcess d;
+    d.append("[limits]\nmax_queue = 2\n");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    int accepted = 0;
+    json last;
+    for (int i = 0; i < 5; ++i) {
+        last = c.request({{"cmd", "say"}, {"text", "Number " + std::to_string(i) + "."}});
+        accepted += last["ok"].get<bool>();
+    }
+    // Two wait, one may already play: never all five.
+    EXPECT_LE(accepted, 3);
+    EXPECT_EQ(last["ok"], false);
+    EXPECT_NE(errorOf(last).find("queue full"), std::string::npos) << last;
+    EXPECT_EQ(d.stop(), 0);
+}
+
+// The longest gap between two recorded commands of one actuator.
+double longestGap(const std::vector<std::pair<double, double>>& stream) {
+    double gap = 0;
+    for (std::size_t i = 1; i < stream.size(); ++i)
+        gap = std::max(gap, stream[i].first - stream[i - 1].first);
+    return gap;
+}
+
+TEST(ClipPreparation, PreparingALongTextNeverStallsTheMouth) {
+    DaemonProcess d;
+    d.append("[limits]\nmax_text_bytes = 16384\nmax_clip_seconds = 3600\n");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    ASSERT_TRUE(c.request({{"cmd", "say"}, {"text", "Open wide, open wide, open wide."}})["ok"]);
+    std::this_thread::sleep_for(700ms);  // it plays
+    std::string text;
+    while (text.size() < 16000) text += "The quick brown fox jumps over the lazy dog. ";
+    c.sendLine(json{{"cmd", "say"}, {"text", text}}.dump());
+    std::this_thread::sleep_for(1500ms);
+    EXPECT_TRUE(json::parse(c.readLine())["ok"]);
+    EXPECT_EQ(d.stop(), 0);
+    const auto jaw = d.recorded("jaw");
+    ASSERT_GT(jaw.size(), 50u);
+    // The recorder gets a command every 10 ms tick; a stalled loop shows as a gap.
+    EXPECT_LT(longestGap(jaw), 0.25) << "the loop stalled while a clip was prepared";
+}
+
+TEST(ClipPreparation, ReloadKeepsWhatPlaysAndWhatWaitsAndAppendsTheRecord) {
+    DaemonProcess d;
+    NotifySocket notify(d.dir / "notify");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    ASSERT_TRUE(
+        c.request({{"cmd", "say"}, {"text", "Hello, this is the first of two lines."}})["ok"]);
+    ASSERT_TRUE(c.request({{"cmd", "say"}, {"text", "And this is the second."}})["ok"]);
+    std::this_thread::sleep_for(800ms);
+    const auto before = c.request({{"cmd", "status"}});
+    ASSERT_FALSE(before["playing"].is_null()) << before;
+    ::kill(d.pid, SIGHUP);
+    ASSERT_TRUE(notify.waitFor("RELOADING=1"));
+    std::this_thread::sleep_for(300ms);
+    const auto after = c.request({{"cmd", "status"}});
+    EXPECT_EQ(after["playing"], before["playing"]) << after;
+    EXPECT_GT(after["position"].get<double>(), before["position"].get<double>()) << after;
+    EXPECT_EQ(after["queue"], before["queue"]) << after;
+    waitUntilIdle(c);
+    EXPECT_EQ(c.request({{"cmd", "status"}})["played"], 2);
+    EXPECT_EQ(d.stop(), 0);
+    const auto jaw = d.recorded("jaw");
+    ASSERT_FALSE(jaw.empty());
+    EXPECT_LT(jaw.front().first, 0.5) << "the record lost what came before the reload";
+    EXPECT_LT(longestGap(jaw), 0.25) << "the mouth stopped across the reload";
+}
+
+}  // namespace
+}  // namespace lipsyncd::test
