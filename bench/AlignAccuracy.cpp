@@ -68,6 +68,7 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"speechInSilenceCost", &dsp::AlignerConfig::speechInSilenceCost},
         {"consonantInSilenceCost", &dsp::AlignerConfig::consonantInSilenceCost},
         {"fillerCostPerFrame", &dsp::AlignerConfig::fillerCostPerFrame},
+        {"edgeFillerCostPerFrame", &dsp::AlignerConfig::edgeFillerCostPerFrame},
         {"silenceLoopCost", &dsp::AlignerConfig::silenceLoopCost},
         {"pauseCost", &dsp::AlignerConfig::pauseCost},
         {"skipWordCost", &dsp::AlignerConfig::skipWordCost},

@@ -92,7 +92,8 @@ void runAlign(const AlignOptions& o) {
         });
     if (!o.words.empty())
         withOutputStream(o.words, [&](std::ostream& out) { writeWords(out, r.alignment.words); });
-    if (!o.runtime.weights.empty()) o.runtime.writeWeights(o.runtime.animate(r.schedule, &r.levels));
+    if (!o.runtime.weights.empty())
+        o.runtime.writeWeights(o.runtime.animate(r.schedule, &r.levels));
 }
 }  // namespace
 

@@ -1,10 +1,12 @@
 // lipsync ctl: the client of lipsyncd's control socket (JSON lines). Requests are built from the
 // daemon's command table and checked against it before they are sent; every wait has a deadline.
 #include <chrono>
+#include <fstream>
 #include <iostream>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/daemon.hpp>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "Commands.hpp"
@@ -18,7 +20,7 @@ struct CtlOptions {
     std::string socket = "/run/lipsyncd/control.sock";
     std::vector<std::string> args;
     int channel = -1;
-    std::string voice;
+    std::string voice, textFile;
     bool wait = false;
     double timeout = 5;
 };
@@ -80,6 +82,14 @@ nlohmann::json requestFrom(const CtlOptions& o) {
     }
     if (o.channel >= 0 && command->name == "play") r["channel"] = o.channel;
     if (!o.voice.empty() && command->name == "say") r["voice"] = o.voice;
+    if (!o.textFile.empty()) {
+        if (command->name != "play") throw CLI::ValidationError("--text-file", "is for play");
+        std::ifstream in(o.textFile);
+        if (!in) throw InputError(o.textFile + ": cannot read");
+        std::ostringstream words;
+        words << in.rdbuf();
+        r["text"] = words.str();
+    }
     if (const auto bad = daemon::checkControlRequest(r)) throw CLI::ValidationError("ctl", *bad);
     return r;
 }
@@ -112,6 +122,9 @@ void addCtlCommand(CLI::App& app) {
     cmd->add_option("--socket", o->socket, "lipsyncd's control socket")->capture_default_str();
     cmd->add_option("--channel", o->channel, "play: analyse only this channel of the file");
     cmd->add_option("--voice", o->voice, "say: espeak-ng voice");
+    cmd->add_option("--text-file", o->textFile,
+                    "play: the words spoken in the file, aligned instead of recognised "
+                    "(default: FILE.txt beside the file, when there is one)");
     cmd->add_option("--timeout", o->timeout, "Seconds to wait for the daemon at each step")
         ->capture_default_str()
         ->check(CLI::Range(0.05, 3600.0));

@@ -64,18 +64,22 @@ std::vector<std::int16_t> decodeForPlayback(const std::filesystem::path& file,
 }
 }  // namespace
 
-Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel) const {
+Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakSynthesizer& synth,
+                         const std::optional<std::string>& knownText,
+                         const std::function<void(const std::string&)>& log) const {
     dsp::DecodeOptions decode;
     decode.channel = channel;
     Clip clip;
     clip.name = file.string();
     // Analysed on `channel` (the voice), played on the others (what the audience hears); the
     // analysis first, so its buffers are gone before the sound's is made.
-    const auto result = dsp::analyzeFile(file, impl_->templates, PhonemeSet::common(), {}, decode);
+    const auto schedule = scheduleForClip(
+        synth, file, knownText, impl_->config.voice, impl_->templates, decode,
+        log ? log : [](const auto&) {});
     {
         // The mouth opens as wide as the voice is loud: its samples, gone before the sound's.
         const auto voice = dsp::readAudioFile(file, decode);
-        clip.weights = impl_->animate(result.schedule, voice.samples, voice.sampleRate);
+        clip.weights = impl_->animate(schedule, voice.samples, voice.sampleRate);
     }
     dsp::DecodeOptions play;
     play.skipChannel = channel;

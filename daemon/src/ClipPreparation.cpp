@@ -8,6 +8,7 @@
 #include <lipsyncd/tts.hpp>
 
 #include "ClipQueue.hpp"
+#include "DaemonCore.hpp"
 
 namespace lipsyncd::daemon {
 
@@ -37,12 +38,13 @@ void checkText(const std::string& text, std::size_t maxBytes) {
 
 Clip prepareClip(const ClipRequest& request, std::unique_ptr<EspeakSynthesizer>& synth) {
     Clip clip;
+    if (!synth) synth = std::make_unique<EspeakSynthesizer>();  // one a process (espeak-ng)
     if (!request.file.empty()) {
         checkAudioFile(request.file, request.maxSeconds);  // again: it may have changed since
-        // request.knownText: alignment (lipsync align) takes it here, when it exists.
-        clip = request.maker->fromFile(request.file, request.channel);
+        // Known words (the request's, or FILE.txt beside it) are aligned, not recognised.
+        clip = request.maker->fromFile(request.file, request.channel, *synth, request.knownText,
+                                       logInfo);
     } else {
-        if (!synth) synth = std::make_unique<EspeakSynthesizer>();
         clip = request.maker->fromText(*synth, request.text, request.voice);
     }
     const double seconds = static_cast<double>(clip.samples.size()) / clip.rate;

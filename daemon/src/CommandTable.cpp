@@ -18,6 +18,8 @@ constexpr std::size_t kMaxVoice = 64;
 constexpr ControlArg kPlayArgs[] = {
     {"file", Type::Path, true, kMaxPath, 0, 0, "the audio file (WAV, FLAC, OGG), a regular file"},
     {"channel", Type::Integer, false, 0, -1, 63, "analyse only this channel (-1: the mix)"},
+    {"text", Type::String, false, kMaxText, 0, 0,
+     "the words spoken in the file: aligned instead of recognised (default: FILE.txt beside it)"},
 };
 constexpr ControlArg kSayArgs[] = {
     {"text", Type::String, true, kMaxText, 0, 0, "what to say"},

@@ -39,6 +39,10 @@ json Daemon::Impl::play(const json& r) {
     ClipRequest request;
     request.file = r["file"].get<std::string>();
     request.channel = r.value("channel", -1);
+    if (r.contains("text")) {
+        request.knownText = r["text"].get<std::string>();
+        checkText(*request.knownText, setup->config.maxTextBytes);
+    }
     request.name = request.file.string();
     request.maxSeconds = setup->config.maxClipSeconds;
     request.maker = setup->clips;

@@ -49,8 +49,9 @@ struct ForcedAligner::State {
     void emitPath(std::int64_t lastFrame, int node);
     void dropFront(std::int64_t frames);
     float emit(const AlignmentNode& n) const {
-        return n.kind == AlignmentNode::Kind::Filler ? config.fillerCostPerFrame
-                                                     : emission[n.phoneme];
+        if (n.kind != AlignmentNode::Kind::Filler) return emission[n.phoneme];
+        const bool after = n.word == graph.words;  // after the last word
+        return after ? config.edgeFillerCostPerFrame : config.fillerCostPerFrame;
     }
 
     AlignmentGraph graph;

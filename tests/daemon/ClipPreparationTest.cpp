@@ -131,3 +131,33 @@ TEST(ClipPreparation, ReloadKeepsWhatPlaysAndWhatWaitsAndAppendsTheRecord) {
 
 }  // namespace
 }  // namespace lipsyncd::test
+
+namespace lipsyncd::test {
+namespace {
+
+// A show file's words beside it (FILE.txt) are aligned, not recognised, and the log says so;
+// play's own text wins over the file beside it.
+TEST(ClipPreparation, KnownWordsBesideAPlayedFileAreAligned) {
+    DaemonProcess d;
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    const auto wav = d.dir / "line.wav";
+    std::filesystem::copy_file(findDataFile("examples/hello.wav"), wav);
+    std::ofstream(d.dir / "line.txt")
+        << "Hello there! I am a puppet. Watch my mouth move when I talk, and wave back at me.\n";
+    ASSERT_TRUE(c.request({{"cmd", "play"}, {"file", wav.string()}})["ok"]);
+    waitUntilIdle(c);
+    EXPECT_NE(d.log().find("words from " + (d.dir / "line.txt").string() + " aligned"),
+              std::string::npos)
+        << d.log();
+    const auto reply =
+        c.request({{"cmd", "play"}, {"file", wav.string()}, {"text", "Hello there!"}});
+    ASSERT_TRUE(reply["ok"]) << reply;
+    waitUntilIdle(c);
+    EXPECT_NE(d.log().find("words from the request"), std::string::npos) << d.log();
+    EXPECT_EQ(d.stop(), 0);
+}
+
+}  // namespace
+}  // namespace lipsyncd::test

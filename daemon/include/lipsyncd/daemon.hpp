@@ -155,7 +155,11 @@ class ClipMaker {
   public:
     explicit ClipMaker(const DaemonConfig& config);
     ~ClipMaker();
-    Clip fromFile(const std::filesystem::path& file, int channel) const;
+    // A file's mouth: with its words (`knownText`, else a FILE.txt beside it) by forced
+    // alignment (lipsync align), else by recognition; `log` says which was used.
+    Clip fromFile(const std::filesystem::path& file, int channel, EspeakSynthesizer& synth,
+                  const std::optional<std::string>& knownText = std::nullopt,
+                  const std::function<void(const std::string&)>& log = {}) const;
     // espeak-ng allows one synthesiser per process, for the process's life: the daemon owns it.
     Clip fromText(EspeakSynthesizer& synth, const std::string& text,
                   const std::string& voice) const;
