@@ -81,17 +81,19 @@ struct Evaluator {
 
     JawScores scoreJaws(const CorpusItem& item, const PhonemeSchedule& reference,
                         const dsp::AnalysisResult& analysis) const {
-        const auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
-        const auto levels = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
         const auto frames = static_cast<std::size_t>(reference.back().end * kFrameRate) + 1;
         const auto truth = lipsync::jawReference(reference, set, kFrameRate, frames);
         const auto score = [&](const PoseTrack& track) {
             return lipsync::scoreJaw(puppet->record(track, kFrameRate, frames), truth, reference,
                                      set, kFrameRate);
         };
-        return {score(o.runtime.animate(analysis.schedule, runtime, &levels)),
-                score(o.runtime.animate(reference, runtime, &levels)),
-                score(envelopeTrack(levels))};
+        // The runtime opens the jaw by the levels the analysis measured, as `analyze --weights`
+        // does; the envelope follower, like a jaw board, hears the audio itself.
+        const auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
+        const auto heard = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
+        return {score(o.runtime.animate(analysis.schedule, runtime, &analysis.levels)),
+                score(o.runtime.animate(reference, runtime, &analysis.levels)),
+                score(envelopeTrack(heard))};
     }
 
     Score scoreFile(const CorpusItem& item) const {

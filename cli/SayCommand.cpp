@@ -40,9 +40,7 @@ void runSay(const SayOptions& o) {
         if (o.raw)
             throw CLI::ValidationError("--weights", "needs the common set: drop --raw-phonemes");
         // The exact schedule, opened as wide as the synthesised speech is loud.
-        std::vector<float> samples(speech.samples.begin(), speech.samples.end());
-        for (auto& x : samples) x /= 32768.0f;
-        const auto levels = dsp::measureLevels(samples, speech.sampleRate);
+        const auto levels = dsp::measureLevels(speech.samples, speech.sampleRate);
         o.runtime.writeWeights(o.runtime.animate(schedule, &levels));
     }
 }

@@ -28,13 +28,13 @@ struct ClipMaker::Impl {
                                         : dsp::TemplateSet::load(findDataFile(c.templates))),
           poseNames(poses.names()) {}
 
-    // The mouth for a schedule, opened as wide as the speech (`samples`) is loud.
-    PoseTrack animate(const PhonemeSchedule& s, std::span<const float> samples, int rate) const {
+    // The mouth for a schedule, opened as wide as the speech (its `levels`) is loud.
+    PoseTrack animate(const PhonemeSchedule& s, const LevelTrack& levels) const {
         lipsync::RuntimeConfig rc;
         rc.outputRate = config.outputRateHz;
         auto track = config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc)
                                                 : lipsync::animate(s, curves, poses, rc);
-        lipsync::shapeByLoudness(poses, dsp::measureLevels(samples, rate), track);
+        lipsync::shapeByLoudness(poses, levels, track);
         return track;
     }
 };
@@ -79,7 +79,8 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
     {
         // The mouth opens as wide as the voice is loud: its samples, gone before the sound's.
         const auto voice = dsp::readAudioFile(file, decode);
-        clip.weights = impl_->animate(schedule, voice.samples, voice.sampleRate);
+        clip.weights =
+            impl_->animate(schedule, dsp::measureLevels(voice.samples, voice.sampleRate));
     }
     dsp::DecodeOptions play;
     play.skipChannel = channel;
@@ -95,11 +96,8 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;
     clip.samples = speech.samples;
-    std::vector<float> level(speech.samples.size());  // for its loudness, then gone
-    std::transform(speech.samples.begin(), speech.samples.end(), level.begin(),
-                   [](std::int16_t x) { return static_cast<float>(x) / 32768.0f; });
     clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr),
-                                  level, clip.rate);
+                                  dsp::measureLevels(speech.samples, speech.sampleRate));
     return clip;
 }
 

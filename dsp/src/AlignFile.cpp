@@ -148,8 +148,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
         aligner.push(f.label.time, analyzer.distances(), f.label.silent);
         speechFrames += !f.label.silent;
-        if (r.levels.db.empty()) r.levels.start = f.label.time;
-        r.levels.db.push_back(f.label.energyDb);
+        r.levels.add(f.label.time, f.label.energyDb);
     });
     analyzer.onSegment([&](const PhonemeSegment& s) { r.audioOnly.push_back(s); });
     std::vector<float> block(kReadBlock);

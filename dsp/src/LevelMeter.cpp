@@ -11,10 +11,18 @@ namespace {
 float toDb(double meanSquare) {
     return static_cast<float>(10 * std::log10(std::max(meanSquare, 1e-12)));
 }
-}  // namespace
 
-LevelTrack measureLevels(std::span<const float> samples, int sampleRate, double frameRate,
-                         double windowSeconds) {
+double sampleValue(float x) {
+    return std::isfinite(x) ? x : 0.0;
+}
+double sampleValue(std::int16_t x) {
+    return x / 32768.0;
+}
+
+// Float samples as they are, 16-bit ones scaled to full scale 1.
+template <class Sample>
+LevelTrack measure(std::span<const Sample> samples, int sampleRate, double frameRate,
+                   double windowSeconds) {
     LevelTrack track;
     track.rate = frameRate;
     if (sampleRate <= 0 || samples.empty()) return track;
@@ -25,7 +33,7 @@ LevelTrack measureLevels(std::span<const float> samples, int sampleRate, double 
     // Running sums of squares make each frame O(1) whatever the window.
     std::vector<double> cumulative(samples.size() + 1, 0.0);
     for (std::size_t i = 0; i < samples.size(); ++i) {
-        const double x = std::isfinite(samples[i]) ? samples[i] : 0.0;
+        const double x = sampleValue(samples[i]);
         cumulative[i + 1] = cumulative[i] + x * x;
     }
     track.db.reserve(frames);
@@ -38,18 +46,26 @@ LevelTrack measureLevels(std::span<const float> samples, int sampleRate, double 
     }
     return track;
 }
+}  // namespace
+
+LevelTrack measureLevels(std::span<const float> samples, int sampleRate, double frameRate,
+                         double windowSeconds) {
+    return measure(samples, sampleRate, frameRate, windowSeconds);
+}
+
+LevelTrack measureLevels(std::span<const std::int16_t> samples, int sampleRate, double frameRate,
+                         double windowSeconds) {
+    return measure(samples, sampleRate, frameRate, windowSeconds);
+}
 
 std::vector<float> followEnvelope(const LevelTrack& levels, const EnvelopeFollowerConfig& c) {
     std::vector<float> out;
     if (levels.db.empty()) return out;
     // The gain knob, set once for the voice: full opening at the speaking level.
-    std::vector<float> sorted(levels.db);
-    const float peak = *std::max_element(sorted.begin(), sorted.end());
-    std::erase_if(sorted, [&](float v) { return v < peak - c.gateBelowPeakDb; });
-    const auto k = static_cast<std::size_t>(c.fullAtPercentile * (sorted.size() - 1));
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
-    const double full = std::pow(10.0, sorted[k] / 20),
-                 gate = std::pow(10.0, (peak - c.gateBelowPeakDb) / 20);
+    const float peak = *std::max_element(levels.db.begin(), levels.db.end());
+    const double full =
+        std::pow(10.0, levels.speakingLevel(c.fullAtPercentile, c.gateBelowPeakDb) / 20);
+    const double gate = std::pow(10.0, (peak - c.gateBelowPeakDb) / 20);
     const double dt = 1 / levels.rate;
     const double attack = 1 - std::exp(-dt / c.attackSeconds);
     const double release = 1 - std::exp(-dt / c.releaseSeconds);

@@ -72,11 +72,8 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     result.inputRate = decoder.sampleRate();
     StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
     analyzer.onSegment([&](const PhonemeSegment& s) { result.schedule.push_back(s); });
-    double lastFrameTime = 0;
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
-        if (result.levels.db.empty()) result.levels.start = f.label.time;
-        result.levels.db.push_back(f.label.energyDb);
-        lastFrameTime = f.label.time;
+        result.levels.add(f.label.time, f.label.energyDb);
         if (keepFrames) result.frames.push_back(f);
     });
     std::vector<float> block(kReadBlock);
@@ -90,9 +87,7 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     result.durationSeconds = static_cast<double>(total) / decoder.sampleRate();
     result.nonFiniteSamples = decoder.nonFiniteSamples();
     if (!result.schedule.empty()) result.schedule.back().end = result.durationSeconds;
-    if (result.levels.db.size() > 1)  // frames are a hop apart, whatever the templates chose
-        result.levels.rate = static_cast<double>(result.levels.db.size() - 1) /
-                             (lastFrameTime - result.levels.start);
+    result.levels.rate = 1 / templates.analysis.hopSeconds;  // the templates' hop rules
     return result;
 }
 

@@ -42,6 +42,12 @@ float fraction(const TomlTable& t, const std::string& key) {
     return static_cast<float>(v);
 }
 
+// The two plateaus of half-width `hold` around the centres lie inside (0, 1) and apart.
+bool plateausFit(const Rules& r, double hold) {
+    return hold > 0 && r.firstCentre - hold > 0 && r.firstCentre + hold < r.secondCentre - hold &&
+           r.secondCentre + hold < 1;
+}
+
 // The jaw pose's target in every class is the class's jaw height (config/phonemes/common.toml),
 // the one table the eval reference is built from too.
 void readJaw(const TomlTable& root, const PoseSet& poses, const PhonemeSet& phonemes, Rules& r) {
@@ -84,16 +90,13 @@ Rules readRules(const TomlTable& root, const PoseSet& poses, const PhonemeSet& p
     r.firstCentre = fraction(root, "first_centre");
     r.secondCentre = fraction(root, "second_centre");
     r.hold = fraction(root, "hold");
-    if (!(r.hold > 0 && r.firstCentre - r.hold > 0 &&
-          r.firstCentre + r.hold < r.secondCentre - r.hold && r.secondCentre + r.hold < 1))
+    if (!plateausFit(r, r.hold))
         root.fail("hold", "the two held plateaus must lie inside (0, 1) and apart");
     const auto targets = root.optTable("targets");
     if (!targets) root.fail("targets", "missing [targets]");
     r.targets.assign(phonemes.size(), std::vector<float>(poses.size(), 0.0f));
     readJaw(root, poses, phonemes, r);
-    if (r.jawPose &&
-        !(r.firstCentre - r.jawHold > 0 && r.firstCentre + r.jawHold < r.secondCentre - r.jawHold &&
-          r.secondCentre + r.jawHold < 1))
+    if (r.jawPose && !plateausFit(r, r.jawHold))
         root.fail("jaw", "the jaw's held plateaus must lie inside (0, 1) and apart");
     readTargets(*targets, poses, phonemes, r);
     if (const auto c = root.optTable("closure")) {

@@ -14,20 +14,6 @@ double relativeLevel(double db, double reference, double rangeDb) {
     return std::clamp((db - (reference - rangeDb)) / rangeDb, 0.0, 1.0);
 }
 
-// The speaking level of an utterance: a high percentile of the frames that are speech (within
-// `speechBelowPeakDb` of the loudest), so a single shout or click does not set it.
-double speakingLevel(std::span<const float> db, const LoudnessConfig& config) {
-    if (db.empty()) return -120;
-    const float peak = *std::max_element(db.begin(), db.end());
-    std::vector<float> speech;
-    for (float v : db)
-        if (v >= peak - config.speechBelowPeakDb) speech.push_back(v);
-    const auto k =
-        static_cast<std::size_t>(config.percentile * static_cast<double>(speech.size() - 1));
-    std::nth_element(speech.begin(), speech.begin() + static_cast<std::ptrdiff_t>(k), speech.end());
-    return speech[k];
-}
-
 void scaleFrame(std::span<const double> gains, double s, std::span<float> weights) {
     for (std::size_t p = 0; p < weights.size(); ++p)
         weights[p] *= static_cast<float>(1 - gains[p] + gains[p] * s);
@@ -44,7 +30,7 @@ void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels, PoseTrack& 
                      const LoudnessConfig& config) {
     if (levels.db.empty() || track.poses.size() != poses.size()) return;
     const auto gains = gainsOf(poses);
-    const double reference = speakingLevel(levels.db, config);
+    const double reference = levels.speakingLevel(config.percentile, config.speechBelowPeakDb);
     for (std::size_t f = 0; f < track.frames(); ++f) {
         const double s = relativeLevel(levels.at(track.times[f]), reference, config.rangeDb);
         scaleFrame(gains, s,

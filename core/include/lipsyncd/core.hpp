@@ -171,6 +171,11 @@ struct LevelTrack {
     std::vector<float> db;  // frame RMS in dBFS
     // The level at time t (nearest frame; the first/last frame outside the track).
     float at(double t) const;
+    // Appends the next frame's level; the first frame's time sets `start`.
+    void add(double time, float frameDb);
+    // The utterance's speaking level: the `percentile` of the frames within `belowPeakDb` of
+    // the loudest, so a single shout or click does not set it; -120 for an empty track.
+    float speakingLevel(double percentile, double belowPeakDb) const;
 };
 
 // ---------------------------------------------------------------------------------------------

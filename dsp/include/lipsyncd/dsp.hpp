@@ -487,6 +487,8 @@ struct AnalysisResult {
 // of `windowSeconds` centred on the frame.
 LevelTrack measureLevels(std::span<const float> samples, int sampleRate, double frameRate = 100,
                          double windowSeconds = 0.03);
+LevelTrack measureLevels(std::span<const std::int16_t> samples, int sampleRate,
+                         double frameRate = 100, double windowSeconds = 0.03);  // 16-bit PCM
 
 // A loudness envelope follower, as the jaw boards sold for animatronics drive a servo: the
 // amplitude envelope (fast attack, slower release), a noise gate, and a gain set so that the
@@ -655,7 +657,7 @@ class ForcedAligner {
 };
 
 struct AlignFileResult {
-    PhonemeSchedule schedule;  // aligned where words were placed, audio-only elsewhere
+    PhonemeSchedule schedule;   // aligned where words were placed, audio-only elsewhere
     PhonemeSchedule audioOnly;  // the front end's own schedule (analyzeFile)
     LevelTrack levels;          // every frame's RMS level (dBFS): how wide the mouth opens
     Alignment alignment;
