@@ -63,8 +63,9 @@ ReferenceFrame referenceAnalysis(std::span<const float> x, const dsp::AnalysisCo
     out.energyDb = rms > 0 ? std::max(20 * std::log10(rms), -120.0) : -120.0;
     std::vector<double> y(n);
     for (std::size_t i = 0; i < n; ++i) {
-        const double hamming = 0.54 - 0.46 * std::cos(2 * std::numbers::pi * static_cast<double>(i) /
-                                                      static_cast<double>(n - 1));
+        const double hamming =
+            0.54 - 0.46 * std::cos(2 * std::numbers::pi * static_cast<double>(i) /
+                                   static_cast<double>(n - 1));
         y[i] = (x[i] - c.preEmphasis * x[i > 0 ? i - 1 : 0]) * hamming;
     }
     const int p = c.order;
