@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace lipsyncd::dsp::kernels {
 
@@ -44,35 +45,50 @@ void preEmphasizeAndWindow(std::span<const float> frame, std::span<const float> 
 }
 
 namespace {
-// Autocorrelation of x[0..n) at lags 0..Lags-1, all lags at once: each sample is multiplied by
-// the Lags samples before it, an inner loop with no dependency between lags and a fixed trip
-// count, which the compiler unrolls and vectorises (x[-Lags+1..-1] must be zeros).
-// On x86-64 the loop is also built for AVX2/FMA and picked at load time (8 lanes instead of 4);
-// other targets (the ARM boards puppets run on) get their own default vectorisation.
+// The longest window the configuration allows: 0.1 s at 48 kHz.
+constexpr std::size_t kMaxWindowSamples = 4800;
+
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define LIPSYNCD_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define LIPSYNCD_VECTOR_CLONES
 #endif
 
-template <int Lags>
+// Eight lags at once (GCC vector extension: AVX on x86-64, NEON on ARM).
+using Lags8 = float __attribute__((vector_size(8 * sizeof(float))));
+
+// Autocorrelation of x[0..n) at lags 0..8·Vectors−1, all lags at once: r[k] = Σ_i x[i]·x[i−k],
+// each lag's sum taken in order of i (x[i] = 0 for i < 0). The samples are
+// first copied in reverse, so that x[i], x[i−1], ..., x[i−7] is one forward load, not a
+// shuffle; the sum of each lag has one dependency chain, and the lags' chains run side by side.
+template <int Vectors>
 LIPSYNCD_VECTOR_CLONES void autocorrelateLags(const float* x, std::size_t n,
                                               std::array<float, kMaxOrder + 1>& r) {
-    std::array<float, Lags> acc{};
+    constexpr int kLags = 8 * Vectors;
+    std::array<float, kMaxWindowSamples + kLags> reversed;  // reversed[j] = x[n − 1 − j]
+    n = std::min(n, kMaxWindowSamples);
+    for (std::size_t j = 0; j < n; ++j) reversed[j] = x[n - 1 - j];
+    std::fill(reversed.begin() + static_cast<std::ptrdiff_t>(n), reversed.end(), 0.0f);
+    Lags8 acc[Vectors] = {};
     for (std::size_t i = 0; i < n; ++i) {
-        const float* past = x + i - (Lags - 1);  // past[Lags - 1 - lag] == x[i - lag]
-        for (int k = 0; k < Lags; ++k) acc[k] += x[i] * past[Lags - 1 - k];
+        const float* past = reversed.data() + (n - 1 - i);  // past[k] == x[i − k]
+        for (int v = 0; v < Vectors; ++v) {
+            Lags8 p;
+            std::memcpy(&p, past + 8 * v, sizeof p);
+            acc[v] += x[i] * p;
+        }
     }
-    std::copy(acc.begin(), acc.end(), r.begin());
+    for (int v = 0; v < Vectors; ++v)
+        for (int k = 0; k < 8 && 8 * v + k <= kMaxOrder; ++k) r[8 * v + k] = acc[v][k];
 }
 }  // namespace
 
 void autocorrelate(const float* y, std::size_t n, int order, std::span<const float> lagWindow,
                    std::array<float, kMaxOrder + 1>& r) {
     if (order < 16)
-        autocorrelateLags<16>(y, n, r);
+        autocorrelateLags<2>(y, n, r);
     else
-        autocorrelateLags<kMaxOrder + 1>(y, n, r);
+        autocorrelateLags<5>(y, n, r);
     for (int lag = 0; lag <= order; ++lag) r[lag] *= lagWindow[lag];
 }
 

@@ -13,11 +13,12 @@ namespace lipsyncd::dsp {
 class DirectLpcSpectrum {
 public:
     DirectLpcSpectrum(int order, int bins);
-    void evaluate(std::span<const float> a, std::span<float> outDb) const;
+    void evaluate(std::span<const float> a, std::span<float> outDb);
 
 private:
     int order_, bins_;
-    std::vector<float> cos_, sin_;  // [m * (order+1) + i]
+    std::vector<float> cos_, sin_;  // [i * bins + m]
+    std::vector<float> re_, im_;    // per bin, reused
 };
 
 class FftLpcSpectrum {

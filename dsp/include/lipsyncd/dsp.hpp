@@ -172,6 +172,7 @@ struct FrameFeatures {
 
 class DirectLpcSpectrum;
 class FftLpcSpectrum;
+class TemplateMatrix;
 
 class FrameAnalyzer {
   public:
@@ -260,11 +261,8 @@ class FrameClassifier {
   private:
     const PhonemeSet* set_;
     ClassifierConfig config_;
-    std::size_t features_ = 0, width_ = 0;  // features per frame; padded row width
-    std::vector<float> scale_;              // √ of the feature weights
-    std::vector<float> matrix_;             // every template, scaled, one padded row each
-    std::vector<int> rowClass_;             // phoneme set index of each row
-    std::vector<float> scaledFrame_, rowDistances_;
+    std::shared_ptr<const TemplateMatrix> matrix_;  // every template, laid out for the distances
+    std::vector<float> scaledFrame_;
     std::vector<float> distances_;
     int sil_ = 0;
     float noiseFloorDb_ = 0;
