@@ -11,7 +11,9 @@ namespace {
 // |A|² below this would be a pole on the unit circle; keeps the log finite (+100 dB cap).
 constexpr float kMinPower = 1e-10f;
 
-float toDb(float re, float im) { return -10.0f * std::log10(std::max(re * re + im * im, kMinPower)); }
+float toDb(float re, float im) {
+    return -10.0f * std::log10(std::max(re * re + im * im, kMinPower));
+}
 }  // namespace
 
 DirectLpcSpectrum::DirectLpcSpectrum(int order, int bins) : order_(order), bins_(bins) {

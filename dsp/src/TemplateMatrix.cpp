@@ -66,12 +66,13 @@ void nearestPerClass(const float* x, std::size_t features, const float* blocks,
                     const Lanes d = x[f + k] - row;
                     acc[k] += d * d;
                 }
-            const Lanes sum = ((acc[0] + acc[4]) + (acc[1] + acc[5])) +
-                              ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+            const Lanes sum =
+                ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
             best = sum < best ? sum : best;
         }
         float m = best[0];
-        for (std::size_t lane = 1; lane < TemplateMatrix::kLanes; ++lane) m = std::min(m, best[lane]);
+        for (std::size_t lane = 1; lane < TemplateMatrix::kLanes; ++lane)
+            m = std::min(m, best[lane]);
         out[cls] = m;
     }
 }

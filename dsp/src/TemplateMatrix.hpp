@@ -33,8 +33,8 @@ class TemplateMatrix {
   private:
     std::size_t features_ = 0;
     std::vector<float> scale_;
-    std::vector<float> blocks_;        // [block][feature][lane]
-    std::vector<int> blockClass_;      // phoneme set index of each block (blocks of a class adjacent)
+    std::vector<float> blocks_;    // [block][feature][lane]
+    std::vector<int> blockClass_;  // phoneme set index of each block (blocks of a class adjacent)
 };
 
 }  // namespace lipsyncd::dsp
