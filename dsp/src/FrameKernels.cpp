@@ -11,16 +11,27 @@ namespace {
 // distorted (flattened), so the classifier trusts it less.
 constexpr float kClipLevel = 0.999f;
 constexpr float kClippedShare = 0.01f;
+
+// Eight lanes (GCC vector extension: AVX on x86-64, NEON on ARM).
+using Lanes8 = float __attribute__((vector_size(8 * sizeof(float))));
+using Counts8 = int __attribute__((vector_size(8 * sizeof(int))));
 }  // namespace
 
-// Eight partial sums let the compiler vectorise.
+// Eight partial sums (sample i into sum i mod 8), one vector of eight lanes.
 FrameLevel measureLevel(std::span<const float> frame, std::size_t n) {
     const std::size_t m = std::min(n, frame.size());
-    std::array<float, 8> squares{};
-    std::array<int, 8> clipped{};
-    for (std::size_t i = 0; i < m; ++i) {
-        squares[i % 8] += frame[i] * frame[i];
-        clipped[i % 8] += std::abs(frame[i]) >= kClipLevel;
+    Lanes8 squares = {};
+    Counts8 clipped = {};
+    std::size_t i = 0;
+    for (; i + 8 <= m; i += 8) {
+        Lanes8 x;
+        std::memcpy(&x, frame.data() + i, sizeof x);
+        squares += x * x;
+        clipped -= (x >= kClipLevel) | (x <= -kClipLevel);  // true is −1
+    }
+    for (std::size_t k = 0; i < m; ++i, ++k) {
+        squares[k] += frame[i] * frame[i];
+        clipped[k] += std::abs(frame[i]) >= kClipLevel;
     }
     double sumSquares = 0;
     int clippedSamples = 0;
@@ -36,11 +47,8 @@ void preEmphasizeAndWindow(std::span<const float> frame, std::span<const float> 
                            float* y) {
     const std::size_t n = window.size();
     const std::size_t m = std::min(n, frame.size());
-    float previous = frame.empty() ? 0.0f : frame[0];
-    for (std::size_t i = 0; i < m; ++i) {
-        y[i] = (frame[i] - alpha * previous) * window[i];
-        previous = frame[i];
-    }
+    if (m > 0) y[0] = (frame[0] - alpha * frame[0]) * window[0];
+    for (std::size_t i = 1; i < m; ++i) y[i] = (frame[i] - alpha * frame[i - 1]) * window[i];
     std::fill(y + m, y + n, 0.0f);
 }
 
@@ -54,9 +62,6 @@ constexpr std::size_t kMaxWindowSamples = 4800;
 #define LIPSYNCD_VECTOR_CLONES
 #endif
 
-// Eight lags at once (GCC vector extension: AVX on x86-64, NEON on ARM).
-using Lags8 = float __attribute__((vector_size(8 * sizeof(float))));
-
 // Autocorrelation of x[0..n) at lags 0..8·Vectors−1, all lags at once: r[k] = Σ_i x[i]·x[i−k],
 // each lag's sum taken in order of i (x[i] = 0 for i < 0). The samples are
 // first copied in reverse, so that x[i], x[i−1], ..., x[i−7] is one forward load, not a
@@ -68,12 +73,12 @@ LIPSYNCD_VECTOR_CLONES void autocorrelateLags(const float* x, std::size_t n,
     std::array<float, kMaxWindowSamples + kLags> reversed;  // reversed[j] = x[n − 1 − j]
     n = std::min(n, kMaxWindowSamples);
     for (std::size_t j = 0; j < n; ++j) reversed[j] = x[n - 1 - j];
-    std::fill(reversed.begin() + static_cast<std::ptrdiff_t>(n), reversed.end(), 0.0f);
-    Lags8 acc[Vectors] = {};
+    std::fill_n(reversed.begin() + static_cast<std::ptrdiff_t>(n), kLags, 0.0f);
+    Lanes8 acc[Vectors] = {};
     for (std::size_t i = 0; i < n; ++i) {
         const float* past = reversed.data() + (n - 1 - i);  // past[k] == x[i − k]
         for (int v = 0; v < Vectors; ++v) {
-            Lags8 p;
+            Lanes8 p;
             std::memcpy(&p, past + 8 * v, sizeof p);
             acc[v] += x[i] * p;
         }
