@@ -15,10 +15,19 @@ constexpr float kClippedShare = 0.01f;
 // Eight lanes (GCC vector extension: AVX on x86-64, NEON on ARM).
 using Lanes8 = float __attribute__((vector_size(8 * sizeof(float))));
 using Counts8 = int __attribute__((vector_size(8 * sizeof(int))));
+
+// On x86-64 the vector loops are also built for AVX2 and picked at load time (one register for
+// eight lanes; the baseline splits them); other targets (the ARM boards puppets run on) get
+// their own default vectorisation.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define LIPSYNCD_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define LIPSYNCD_VECTOR_CLONES
+#endif
 }  // namespace
 
 // Eight partial sums (sample i into sum i mod 8), one vector of eight lanes.
-FrameLevel measureLevel(std::span<const float> frame, std::size_t n) {
+LIPSYNCD_VECTOR_CLONES FrameLevel measureLevel(std::span<const float> frame, std::size_t n) {
     const std::size_t m = std::min(n, frame.size());
     Lanes8 squares = {};
     Counts8 clipped = {};
@@ -55,12 +64,6 @@ void preEmphasizeAndWindow(std::span<const float> frame, std::span<const float> 
 namespace {
 // The longest window the configuration allows: 0.1 s at 48 kHz.
 constexpr std::size_t kMaxWindowSamples = 4800;
-
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define LIPSYNCD_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define LIPSYNCD_VECTOR_CLONES
-#endif
 
 // Autocorrelation of x[0..n) at lags 0..8·Vectors−1, all lags at once: r[k] = Σ_i x[i]·x[i−k],
 // each lag's sum taken in order of i (x[i] = 0 for i < 0). The samples are
