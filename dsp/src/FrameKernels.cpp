@@ -66,9 +66,9 @@ namespace {
 constexpr std::size_t kMaxWindowSamples = 4800;
 
 // Autocorrelation of x[0..n) at lags 0..8·Vectors−1, all lags at once: r[k] = Σ_i x[i]·x[i−k],
-// each lag's sum taken in order of i (x[i] = 0 for i < 0). The samples are
-// first copied in reverse, so that x[i], x[i−1], ..., x[i−7] is one forward load, not a
-// shuffle; the sum of each lag has one dependency chain, and the lags' chains run side by side.
+// each lag's sum taken in order of i (x[i] = 0 for i < 0). The samples are first copied in
+// reverse, so that x[i], x[i−1], ..., x[i−7] is one forward load, not a shuffle; each lag's sum
+// is one dependency chain, and the lags' chains run side by side.
 template <int Vectors>
 LIPSYNCD_VECTOR_CLONES void autocorrelateLags(const float* x, std::size_t n,
                                               std::array<float, kMaxOrder + 1>& r) {

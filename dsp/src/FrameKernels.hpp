@@ -21,7 +21,7 @@ FrameLevel measureLevel(std::span<const float> frame, std::size_t windowLength);
 void preEmphasizeAndWindow(std::span<const float> frame, std::span<const float> window, float alpha,
                            float* y);
 
-// r[0..order] of y[0..n), lag window applied. y[−kMaxOrder..−1] must be readable zeros.
+// r[0..order] of y[0..n) (samples before y[0] count as zeros), lag window applied.
 void autocorrelate(const float* y, std::size_t n, int order, std::span<const float> lagWindow,
                    std::array<float, kMaxOrder + 1>& r);
 
