@@ -9,6 +9,8 @@
 #include <limits>
 #include <lipsyncd/dsp.hpp>
 
+#include "TemplateMatrix.hpp"
+
 namespace lipsyncd::dsp {
 
 namespace {
@@ -20,24 +22,8 @@ constexpr float kInitialNoiseFloorDb = -70.0f;
 FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet& set,
                                  const ClassifierConfig& config)
     : set_(&set), config_(config) {
-    // Σ w·(x−t)² = Σ (√w·x − √w·t)²: templates are stored scaled by √w, in one flat matrix
-    // with rows padded to a multiple of 8, so a frame costs one scaling and one pass.
-    features_ = templates.binWeights.size();
-    width_ = (features_ + 7) / 8 * 8;
-    scale_.assign(width_, 0.0f);
-    for (std::size_t b = 0; b < features_; ++b) scale_[b] = std::sqrt(templates.binWeights[b]);
-    for (const auto& c : templates.classes) {
-        const auto idx = set.find(c.phoneme);
-        if (!idx)
-            throw InputError("templates: class '" + c.phoneme + "' is not in the phoneme set");
-        for (const auto& t : c.spectra) {
-            rowClass_.push_back(static_cast<int>(*idx));
-            for (std::size_t b = 0; b < width_; ++b)
-                matrix_.push_back(b < features_ ? t[b] * scale_[b] : 0.0f);
-        }
-    }
-    scaledFrame_.assign(width_, 0.0f);
-    rowDistances_.assign(rowClass_.size(), 0.0f);
+    matrix_ = std::make_shared<const TemplateMatrix>(templates, set);
+    scaledFrame_.assign(matrix_->features(), 0.0f);
     distances_.assign(set.size(), std::numeric_limits<float>::infinity());
     sil_ = static_cast<int>(set.silence());
     reset();
@@ -48,28 +34,6 @@ void FrameClassifier::reset() {
     floorInitialised_ = false;
     lastTime_ = 0;
 }
-
-namespace {
-// Squared distance from x to every row of a matrix (rows of `width` floats, a multiple of 8),
-// in eight interleaved partial sums so the loop vectorises; on x86-64 also built for AVX2 and
-// picked at load time (the whole loop, so the per-row work stays inlined).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void squaredDistances(const float* x, const float* matrix, std::size_t rows, std::size_t width,
-                      float* out) {
-    for (std::size_t row = 0; row < rows; ++row, matrix += width) {
-        std::array<float, 8> acc{};
-        for (std::size_t i = 0; i < width; i += 8)
-            for (std::size_t k = 0; k < 8; ++k) {
-                const float d = x[i + k] - matrix[i + k];
-                acc[k] += d * d;
-            }
-        out[row] =
-            ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-    }
-}
-}  // namespace
 
 FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
     FrameLabel label;
@@ -103,15 +67,12 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         label.silent = true;
         return label;
     }
-    for (std::size_t b = 0; b < features_; ++b) scaledFrame_[b] = frame.spectrum[b] * scale_[b];
-    squaredDistances(scaledFrame_.data(), matrix_.data(), rowClass_.size(), width_,
-                     rowDistances_.data());
-    for (std::size_t row = 0; row < rowClass_.size(); ++row) {
-        float& slot = distances_[static_cast<std::size_t>(rowClass_[row])];
-        slot = std::min(slot, rowDistances_[row]);
-    }
+    const auto scale = matrix_->scale();
+    for (std::size_t b = 0; b < scale.size(); ++b) scaledFrame_[b] = frame.spectrum[b] * scale[b];
+    matrix_->nearest(scaledFrame_, distances_);
+    const auto features = static_cast<float>(scale.size());
     for (auto& d : distances_)  // weighted RMS difference, in dB
-        if (std::isfinite(d)) d = std::sqrt(d / static_cast<float>(features_));
+        if (std::isfinite(d)) d = std::sqrt(d / features);
 
     const int sil = sil_;
     int first = -1, second = -1;

@@ -24,9 +24,11 @@ LpcResult levinsonDurbin(std::span<const float> r, int order) {
         out.normalizedError = 1;
         return out;
     }
+    std::array<double, kMaxOrder + 1> rd{};  // r in double once, not in every product
+    for (int i = 0; i <= order; ++i) rd[i] = r[i];
     for (int i = 1; i <= order; ++i) {
-        double acc = r[i];
-        for (int j = 1; j < i; ++j) acc += a[j] * r[i - j];
+        double acc = rd[i];
+        for (int j = 1; j < i; ++j) acc += a[j] * rd[i - j];
         const double k = -acc / error;
         if (!(std::abs(k) < 1.0)) {  // also catches NaN: the frame is degenerate
             out.stable = false;

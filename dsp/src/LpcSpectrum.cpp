@@ -11,34 +11,44 @@ namespace {
 // |A|² below this would be a pole on the unit circle; keeps the log finite (+100 dB cap).
 constexpr float kMinPower = 1e-10f;
 
-float toDb(float re, float im) { return -10.0f * std::log10(std::max(re * re + im * im, kMinPower)); }
+float toDb(float re, float im) {
+    return -10.0f * std::log10(std::max(re * re + im * im, kMinPower));
+}
 }  // namespace
 
 DirectLpcSpectrum::DirectLpcSpectrum(int order, int bins) : order_(order), bins_(bins) {
+    // Tables by coefficient, then bin: the loop over bins is the inner one and vectorises, and
+    // each bin's sums are still taken in order of the coefficients.
     const auto n = static_cast<std::size_t>(bins) * static_cast<std::size_t>(order + 1);
     cos_.resize(n);
     sin_.resize(n);
     for (int m = 0; m < bins; ++m) {
         const double w = std::numbers::pi * m / bins;
         for (int i = 0; i <= order; ++i) {
-            cos_[m * (order + 1) + i] = static_cast<float>(std::cos(w * i));
-            sin_[m * (order + 1) + i] = static_cast<float>(std::sin(w * i));
+            cos_[i * bins + m] = static_cast<float>(std::cos(w * i));
+            sin_[i * bins + m] = static_cast<float>(std::sin(w * i));
         }
     }
+    re_.resize(static_cast<std::size_t>(bins));
+    im_.resize(static_cast<std::size_t>(bins));
 }
 
-void DirectLpcSpectrum::evaluate(std::span<const float> a, std::span<float> outDb) const {
+void DirectLpcSpectrum::evaluate(std::span<const float> a, std::span<float> outDb) {
     const int n = order_ + 1;
-    for (int m = 0; m < bins_; ++m) {
-        const float* c = &cos_[m * n];
-        const float* s = &sin_[m * n];
-        float re = 0, im = 0;
-        for (int i = 0; i < n; ++i) {
-            re += a[i] * c[i];
-            im -= a[i] * s[i];
+    std::fill(re_.begin(), re_.end(), 0.0f);
+    std::fill(im_.begin(), im_.end(), 0.0f);
+    float* re = re_.data();
+    float* im = im_.data();
+    for (int i = 0; i < n; ++i) {
+        const float ai = a[i];
+        const float* c = &cos_[i * bins_];
+        const float* s = &sin_[i * bins_];
+        for (int m = 0; m < bins_; ++m) {
+            re[m] += ai * c[m];
+            im[m] -= ai * s[m];
         }
-        outDb[m] = toDb(re, im);
     }
+    for (int m = 0; m < bins_; ++m) outDb[m] = toDb(re[m], im[m]);
 }
 
 FftLpcSpectrum::FftLpcSpectrum(int bins) : bins_(bins), size_(2 * bins) {

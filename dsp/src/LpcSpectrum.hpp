@@ -11,21 +11,22 @@
 namespace lipsyncd::dsp {
 
 class DirectLpcSpectrum {
-public:
+  public:
     DirectLpcSpectrum(int order, int bins);
-    void evaluate(std::span<const float> a, std::span<float> outDb) const;
+    void evaluate(std::span<const float> a, std::span<float> outDb);
 
-private:
+  private:
     int order_, bins_;
-    std::vector<float> cos_, sin_;  // [m * (order+1) + i]
+    std::vector<float> cos_, sin_;  // [i * bins + m]
+    std::vector<float> re_, im_;    // per bin, reused
 };
 
 class FftLpcSpectrum {
-public:
+  public:
     explicit FftLpcSpectrum(int bins);  // bins must be a power of two
     void evaluate(std::span<const float> a, std::span<float> outDb);
 
-private:
+  private:
     int bins_, size_;
     std::vector<float> re_, im_, twiddleRe_, twiddleIm_;
     std::vector<int> bitReverse_;

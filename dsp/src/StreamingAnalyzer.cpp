@@ -71,6 +71,12 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     AnalysisResult result;
     result.inputRate = decoder.sampleRate();
     StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
+    // One level a frame is all that grows with the input (besides the schedule): reserved at
+    // once when the length is known, so an hour does not pass through doubling copies.
+    if (const auto frames = decoder.frames())
+        result.levels.db.reserve(static_cast<std::size_t>(
+            static_cast<double>(*frames) / decoder.sampleRate() / templates.analysis.hopSeconds +
+            2));
     analyzer.onSegment([&](const PhonemeSegment& s) { result.schedule.push_back(s); });
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
         result.levels.add(f.label.time, f.label.energyDb);

@@ -9,6 +9,8 @@
 #include <limits>
 #include <lipsyncd/dsp.hpp>
 
+#include "ClassEntry.hpp"
+
 namespace lipsyncd::dsp {
 
 namespace {
@@ -28,13 +30,14 @@ ViterbiDecoder::ViterbiDecoder(const TransitionModel& model, const PhonemeSet& s
     for (std::size_t m = 0; m < model.classes.size(); ++m)
         if (const auto idx = set.find(model.classes[m])) modelIndex[*idx] = static_cast<int>(m);
     const float uniform = -std::log(static_cast<float>(std::max<std::size_t>(classes_ - 1, 1)));
-    transition_.assign(classes_ * classes_, kUnreachable);
+    stride_ = (classes_ + 7) / 8 * 8;
+    transition_.assign(classes_ * stride_, kUnreachable);
     for (std::size_t from = 0; from < classes_; ++from)
         for (std::size_t to = 0; to < classes_; ++to) {
             if (from == to) continue;
             const int mf = modelIndex[from], mt = modelIndex[to];
             const float logP = mf >= 0 && mt >= 0 ? model.logProb[mf][mt] : uniform;
-            transition_[to * classes_ + from] =  // by destination: one row per entry
+            transition_[from * stride_ + to] =
                 -config.transitionWeight * logP + config.switchPenalty;
         }
     for (std::size_t c = 0; c < classes_; ++c) {
@@ -48,6 +51,8 @@ ViterbiDecoder::ViterbiDecoder(const TransitionModel& model, const PhonemeSet& s
     next_.assign(states_, kUnreachable);
     emission_.assign(classes_, 0.0f);
     exitScore_.assign(classes_, kUnreachable);
+    enter_.assign(stride_, kUnreachable);
+    entryFrom_.assign(stride_, -1);
     if (lag_ >= 0) {
         back_.assign(static_cast<std::size_t>(lag_ + 1) * states_, 0);
         pending_.reserve(static_cast<std::size_t>(lag_) + 2);
@@ -88,19 +93,12 @@ void ViterbiDecoder::step(const FrameLabel& label, std::span<const float> distan
         std::fill(back, back + states_, std::uint16_t{0});
     } else {
         for (std::size_t j = 0; j < classes_; ++j) exitScore_[j] = score_[lastState_[j]];
+        // Entering each class: from the last state of the best other class.
+        bestEntries(exitScore_.data(), transition_.data(), classes_, stride_, kUnreachable,
+                    enter_.data(), entryFrom_.data());
         for (std::size_t c = 0; c < classes_; ++c) {
-            // Entering class c: from the last state of the best other class. The minimum first
-            // (a loop without branches, which vectorises), then which class gave it.
-            const float* toC = transition_.data() + c * classes_;
-            float enter = kUnreachable;
-            for (std::size_t j = 0; j < classes_; ++j)
-                enter = std::min(enter, exitScore_[j] + toC[j]);
-            int from = lastState_[c];
-            for (std::size_t j = 0; j < classes_; ++j)
-                if (exitScore_[j] + toC[j] == enter) {
-                    from = lastState_[j];
-                    break;
-                }
+            const float enter = enter_[c];
+            const int from = entryFrom_[c] >= 0 ? lastState_[entryFrom_[c]] : lastState_[c];
             const int first = firstState_[c], last = lastState_[c];
             for (int s = last; s > first; --s) {  // along the chain
                 float stay = score_[s - 1];

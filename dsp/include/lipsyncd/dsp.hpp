@@ -172,6 +172,7 @@ struct FrameFeatures {
 
 class DirectLpcSpectrum;
 class FftLpcSpectrum;
+class TemplateMatrix;
 
 class FrameAnalyzer {
   public:
@@ -260,11 +261,8 @@ class FrameClassifier {
   private:
     const PhonemeSet* set_;
     ClassifierConfig config_;
-    std::size_t features_ = 0, width_ = 0;  // features per frame; padded row width
-    std::vector<float> scale_;              // √ of the feature weights
-    std::vector<float> matrix_;             // every template, scaled, one padded row each
-    std::vector<int> rowClass_;             // phoneme set index of each row
-    std::vector<float> scaledFrame_, rowDistances_;
+    std::shared_ptr<const TemplateMatrix> matrix_;  // every template, laid out for the distances
+    std::vector<float> scaledFrame_;
     std::vector<float> distances_;
     int sil_ = 0;
     float noiseFloorDb_ = 0;
@@ -370,13 +368,16 @@ class ViterbiDecoder {
 
     std::size_t classes_ = 0, states_ = 0;
     std::vector<int> stateClass_, firstState_, lastState_;
-    std::vector<float> transition_;  // [to * classes + from], costs
+    std::size_t stride_ = 0;         // classes rounded up to a multiple of 8
+    std::vector<float> transition_;  // [from * stride + to], costs
     DecoderConfig config_;
     int lag_ = 0;  // frames; < 0 offline
     double hop_ = 0.01;
     int sil_ = 0;
     std::vector<float> score_, next_, emission_;
     std::vector<float> exitScore_;     // per class: the score of its last state
+    std::vector<float> enter_;         // per class: the best score entering it this frame
+    std::vector<int> entryFrom_;       // per class: the class that entry comes from (−1: none)
     std::vector<std::uint16_t> back_;  // [frame slot][state]: the state before
     std::vector<FrameLabel> pending_;  // labels not yet decided, oldest first
     std::size_t frames_ = 0, decided_ = 0;

@@ -1,0 +1,87 @@
+#include "TemplateMatrix.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace lipsyncd::dsp {
+
+TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& set)
+    : features_(templates.binWeights.size()) {
+    scale_.resize(features_);
+    for (std::size_t b = 0; b < features_; ++b) scale_[b] = std::sqrt(templates.binWeights[b]);
+    for (const auto& c : templates.classes) {
+        const auto idx = set.find(c.phoneme);
+        if (!idx)
+            throw InputError("templates: class '" + c.phoneme + "' is not in the phoneme set");
+        for (std::size_t first = 0; first < c.spectra.size(); first += kLanes) {
+            const std::size_t at = blocks_.size();
+            blocks_.resize(at + features_ * kLanes);
+            for (std::size_t lane = 0; lane < kLanes; ++lane) {
+                const auto& t = c.spectra[std::min(first + lane, c.spectra.size() - 1)];
+                for (std::size_t b = 0; b < features_; ++b)
+                    blocks_[at + b * kLanes + lane] = t[b] * scale_[b];
+            }
+            blockClass_.push_back(static_cast<int>(*idx));
+        }
+    }
+}
+
+namespace {
+// Eight templates at once, one per lane (GCC vector extension: AVX on x86-64, NEON on ARM).
+using Lanes = float __attribute__((vector_size(TemplateMatrix::kLanes * sizeof(float))));
+
+// Squared distances from x to the eight templates of one block. Feature f goes into partial
+// sum f mod 8, as in a row loop of eight partial sums.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void nearestPerClass(const float* x, std::size_t features, const float* blocks,
+                     const int* blockClass, std::size_t blockCount, float* out) {
+    const std::size_t stride = features * TemplateMatrix::kLanes;
+    const std::size_t whole = features / 8 * 8;
+    for (std::size_t block = 0; block < blockCount;) {
+        const int cls = blockClass[block];
+        Lanes best;
+        for (std::size_t lane = 0; lane < TemplateMatrix::kLanes; ++lane)
+            best[lane] = std::numeric_limits<float>::infinity();
+        for (; block < blockCount && blockClass[block] == cls; ++block) {
+            const float* t = blocks + block * stride;
+            Lanes acc[8] = {};
+            std::size_t f = 0;
+            for (; f < whole; f += 8)
+#pragma GCC unroll 8
+                for (std::size_t k = 0; k < 8; ++k) {
+                    Lanes row;
+                    std::memcpy(&row, t + (f + k) * TemplateMatrix::kLanes, sizeof row);
+                    const Lanes d = x[f + k] - row;
+                    acc[k] += d * d;
+                }
+#pragma GCC unroll 8
+            for (std::size_t k = 0; k < 8; ++k)
+                if (f + k < features) {
+                    Lanes row;
+                    std::memcpy(&row, t + (f + k) * TemplateMatrix::kLanes, sizeof row);
+                    const Lanes d = x[f + k] - row;
+                    acc[k] += d * d;
+                }
+            const Lanes sum =
+                ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+            best = sum < best ? sum : best;
+        }
+        float m = best[0];
+        for (std::size_t lane = 1; lane < TemplateMatrix::kLanes; ++lane)
+            m = std::min(m, best[lane]);
+        out[cls] = m;
+    }
+}
+}  // namespace
+
+void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out) const {
+    std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
+    nearestPerClass(scaledFrame.data(), features_, blocks_.data(), blockClass_.data(),
+                    blockClass_.size(), out.data());
+}
+
+}  // namespace lipsyncd::dsp

@@ -1,0 +1,40 @@
+// Every template of a set, laid out for the classifier's distance loop. Σ w·(x−t)² =
+// Σ (√w·x − √w·t)²: templates are stored scaled by √w. Per class, its templates go in blocks of
+// eight (the last block padded with copies of the class's last template, which cannot change a
+// minimum), each block feature-major ([feature][8 templates]), so that one vector operation
+// serves eight templates and no per-template horizontal sum is needed.
+//
+// Each template's sum is formed exactly as a row-by-row loop with eight partial sums forms it
+// (feature f into partial sum f mod 8, in order; the partial sums added as
+// ((0+4)+(1+5))+((2+6)+(3+7))), so the distances do not depend on the layout.
+#pragma once
+
+#include <cstddef>
+#include <lipsyncd/dsp.hpp>
+#include <span>
+#include <vector>
+
+namespace lipsyncd::dsp {
+
+class TemplateMatrix {
+  public:
+    static constexpr std::size_t kLanes = 8;
+
+    TemplateMatrix() = default;
+    // Throws InputError for a class the phoneme set does not have.
+    TemplateMatrix(const TemplateSet& templates, const PhonemeSet& set);
+    std::size_t features() const { return features_; }
+    // √ of each feature's weight: the frame is scaled by these before nearest().
+    std::span<const float> scale() const { return scale_; }
+    // Squared weighted distance from a scaled frame to the nearest template of each class,
+    // indexed by phoneme set index; +inf for classes without templates.
+    void nearest(std::span<const float> scaledFrame, std::span<float> out) const;
+
+  private:
+    std::size_t features_ = 0;
+    std::vector<float> scale_;
+    std::vector<float> blocks_;    // [block][feature][lane]
+    std::vector<int> blockClass_;  // phoneme set index of each block (blocks of a class adjacent)
+};
+
+}  // namespace lipsyncd::dsp
