@@ -50,7 +50,9 @@ Preview makePreview(const std::string& source, const PhonemeSchedule& schedule,
 
 // 16-bit mono PCM as a WAV file in a data: URI, for the page's <audio>.
 std::string wavDataUri(std::span<const std::int16_t> samples, int sampleRate);
-// Base64 (RFC 4648, section 4), bare or in a data: URI ("data:audio/wav;base64,...");
+// Base64 (RFC 4648, section 4).
+std::string encodeBase64(std::string_view bytes);
+// Base64, bare or in a data: URI ("data:audio/wav;base64,...");
 // nullopt when it is not.
 std::optional<std::string> decodeBase64(std::string_view text);
 

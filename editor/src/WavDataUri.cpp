@@ -13,8 +13,17 @@ void putLe(std::string& out, std::uint32_t v, int bytes) {
     for (int i = 0; i < bytes; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
 }
 
-// RFC 4648, section 4.
-std::string base64(const std::string& in) {
+int digitValue(char c) {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+') return 62;
+    if (c == '/') return 63;
+    return -1;
+}
+}  // namespace
+
+std::string encodeBase64(std::string_view in) {
     static constexpr char kDigits[] =
         "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
@@ -30,16 +39,6 @@ std::string base64(const std::string& in) {
     }
     return out;
 }
-
-int digitValue(char c) {
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+') return 62;
-    if (c == '/') return 63;
-    return -1;
-}
-}  // namespace
 
 std::optional<std::string> decodeBase64(std::string_view in) {
     if (const auto comma = in.find(','); in.starts_with("data:")) {
@@ -81,7 +80,7 @@ std::string wavDataUri(std::span<const std::int16_t> samples, int sampleRate) {
     wav += "data";
     putLe(wav, dataBytes, 4);
     for (const auto s : samples) putLe(wav, static_cast<std::uint16_t>(s), 2);
-    return "data:audio/wav;base64," + base64(wav);
+    return "data:audio/wav;base64," + encodeBase64(wav);
 }
 
 }  // namespace lipsyncd::editor
