@@ -66,8 +66,8 @@ nlohmann::json weightsOf(const ControlArg& arg, std::span<const std::string> wor
         } catch (const std::exception&) {
         }
         if (eq == std::string::npos || eq == 0 || used == 0 || eq + 1 + used != word.size())
-            throw CLI::ValidationError("ctl", "'" + word + "' is not NAME=VALUE: " +
-                                                  std::string(arg.help));
+            throw CLI::ValidationError(
+                "ctl", "'" + word + "' is not NAME=VALUE: " + std::string(arg.help));
         weights[word.substr(0, eq)] = value;
     }
     return weights;

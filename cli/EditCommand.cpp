@@ -71,8 +71,8 @@ void runEdit(const EditOptions& o) {
     std::cout << "lipsync edit: " << server.url() << '\n'
               << "lipsync edit: "
               << (o.character.empty() ? "no --character: saving is off" : "saves to " + o.character)
-              << (puppet ? "; the preview moves '" + puppet->puppet() + "' (lipsyncd, " +
-                               o.socket + ")"
+              << (puppet ? "; the preview moves '" + puppet->puppet() + "' (lipsyncd, " + o.socket +
+                               ")"
                          : std::string())
               << "; Ctrl-C stops" << std::endl;
     if (!o.noOpen) openInBrowser(server.url());
@@ -90,7 +90,9 @@ void runEdit(const EditOptions& o) {
 void addEditCommand(CLI::App& app) {
     auto o = std::make_shared<EditOptions>();
     auto* cmd = app.add_subcommand(
-        "edit", "Edit bigram curves in a browser: drag control points, hear and see a sentence");
+        "edit",
+        "Edit bigram curves in a browser: drag control points, hear and see a sentence or a "
+        "recording with its words (and, with --socket, the puppet lipsyncd drives)");
     cmd->add_option("--curves", o->curves, "Base curve set (config/curves/NAME.json, or a file)")
         ->capture_default_str();
     cmd->add_option("--character", o->character,
@@ -100,7 +102,9 @@ void addEditCommand(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--phonemes", o->phonemes, "Phoneme set: common, mandarin, or a file")
         ->capture_default_str();
-    cmd->add_option("--voice", o->voice, "espeak-ng voice for the preview")->capture_default_str();
+    cmd->add_option("--voice", o->voice,
+                    "espeak-ng voice for the preview (and for reading a recording's words)")
+        ->capture_default_str();
     cmd->add_option("--socket", o->socket,
                     "lipsyncd's control socket: the preview moves the puppet it drives too");
     cmd->add_option("--puppet", o->puppet,

@@ -58,10 +58,15 @@ ordered_json points(std::span<const lipsync::ControlPoint> polygon) {
     return out;
 }
 
+// A request the API cannot even read: 400, where input it reads and refuses is 422.
+struct MalformedRequest : InputError {
+    using InputError::InputError;
+};
+
 json parseBody(const std::string& body) {
     auto j = json::parse(body, nullptr, false);
     if (j.is_discarded() || !j.is_object())
-        throw InputError("request body: expected a JSON object");
+        throw MalformedRequest("request body: expected a JSON object");
     return j;
 }
 }  // namespace
@@ -80,6 +85,8 @@ ApiResponse EditorApi::handle(const ApiRequest& request) {
     std::lock_guard lock(mutex_);
     try {
         return route(request);
+    } catch (const MalformedRequest& e) {
+        return error(400, e.what());
     } catch (const InputError& e) {
         return error(422, e.what());
     } catch (const std::exception& e) {
@@ -125,7 +132,8 @@ ApiResponse EditorApi::listBigrams() const {
     j["character"] = draft_.characterFile().string();
     j["base"] = draft_.baseName();
     j["unsaved"] = draft_.unsaved();
-    j["puppet"] = settings_.puppet ? ordered_json(settings_.puppet->puppet()) : ordered_json(nullptr);
+    j["puppet"] =
+        settings_.puppet ? ordered_json(settings_.puppet->puppet()) : ordered_json(nullptr);
     auto& mouth = j["mouth"];
     mouth["parameters"] = mouth_.parameters;
     mouth["neutral"] = mouth_.neutral;
@@ -164,12 +172,7 @@ ApiResponse EditorApi::bigram(std::size_t first, std::size_t second) const {
 }
 
 ApiResponse EditorApi::putBigram(std::size_t first, std::size_t second, const ApiRequest& request) {
-    json body;
-    try {
-        body = parseBody(request.body);
-    } catch (const InputError& e) {
-        return error(400, e.what());
-    }
+    const auto body = parseBody(request.body);
     if (!body.contains("poses") || !body["poses"].is_object())
         return error(400, "request body: expected {\"poses\": {\"POSE\": [[t, v], ...], ...}}");
     draft_.replace(
@@ -179,12 +182,7 @@ ApiResponse EditorApi::putBigram(std::size_t first, std::size_t second, const Ap
 }
 
 ApiResponse EditorApi::preview(const ApiRequest& request) {
-    json body;
-    try {
-        body = parseBody(request.body);
-    } catch (const InputError& e) {
-        return error(400, e.what());
-    }
+    const auto body = parseBody(request.body);
     auto voice = settings_.voice;
     if (body.contains("voice")) {
         if (!body["voice"].is_string() || !isVoiceName(body["voice"].get<std::string>()))
@@ -221,8 +219,9 @@ ApiResponse EditorApi::preview(const ApiRequest& request) {
 ApiResponse EditorApi::previewRecording(const json& body, const std::string& voice,
                                         const lipsync::RuntimeConfig& runtime) {
     if (!body["wav"].is_string())
-        return error(400, "wav: expected the file's bytes in base64 (\"data:audio/wav;base64,"
-                          "...\"), not a path");
+        return error(400,
+                     "wav: expected the file's bytes in base64 (\"data:audio/wav;base64,"
+                     "...\"), not a path");
     const auto& encoded = body["wav"].get_ref<const std::string&>();
     // Base64 grows 3 bytes to 4; a data: URI's head is short.
     if (encoded.size() > settings_.maxUploadBytes / 3 * 4 + 64)
@@ -230,8 +229,9 @@ ApiResponse EditorApi::previewRecording(const json& body, const std::string& voi
                               " MiB; preview a shorter recording");
     const auto bytes = decodeBase64(encoded);
     if (!bytes)
-        return error(400, "wav: not base64 (expected \"data:audio/wav;base64,...\" or the "
-                          "base64 of the file)");
+        return error(400,
+                     "wav: not base64 (expected \"data:audio/wav;base64,...\" or the "
+                     "base64 of the file)");
     if (bytes->empty()) return error(400, "wav: empty");
     std::optional<std::string> text;
     if (body.contains("text")) {
@@ -260,12 +260,7 @@ ApiResponse EditorApi::previewRecording(const json& body, const std::string& voi
 // {"from": seconds} when the page starts playing the preview's audio (from there), {"stop":
 // true} when it pauses: the puppet follows the page.
 ApiResponse EditorApi::perform(const ApiRequest& request) {
-    json body;
-    try {
-        body = parseBody(request.body);
-    } catch (const InputError& e) {
-        return error(400, e.what());
-    }
+    const auto body = parseBody(request.body);
     auto* puppet = settings_.puppet;
     if (!puppet)
         return error(409, "no puppet: start `lipsync edit --socket PATH` with lipsyncd running");

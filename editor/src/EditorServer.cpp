@@ -46,7 +46,7 @@ EditorServer::EditorServer(EditorApi& api, const ServerOptions& options)
                             "default-src 'self'; media-src 'self' data:; img-src 'self' data:"}});
     s.set_payload_max_length(kMaxBody);
     s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req,
-                                                                  httplib::Response& res) {
+                                                                httplib::Response& res) {
         // The server's own refusal of a body over kMaxBody comes without one; the API's
         // answers keep theirs.
         if (res.status != 413 || !res.body.empty())

@@ -37,8 +37,8 @@ PuppetStream::PuppetStream(std::filesystem::path socket, const std::string& pupp
     daemon::ControlClient client(socket_, kTimeout);
     const auto status = client.request({{"cmd", "status"}});
     if (!status.value("ok", false) || !status.contains("puppet") || !status["puppet"].is_string())
-        throw InputError(socket_.string() + ": not lipsyncd's control socket (status: " +
-                         status.dump() + ")");
+        throw InputError(socket_.string() +
+                         ": not lipsyncd's control socket (status: " + status.dump() + ")");
     puppet_ = status["puppet"].get<std::string>();
     if (!puppet.empty() && puppet != puppet_)
         throw InputError(socket_.string() + ": lipsyncd drives the puppet '" + puppet_ +

@@ -65,8 +65,9 @@ Preview renderRecordingPreview(EspeakSynthesizer& speech, const dsp::TemplateSet
     std::vector<std::string> warnings;
     std::optional<dsp::AlignFileResult> aligned;
     if (!text) {
-        warnings.push_back("no words given: audio-only analysis (give the words spoken in the "
-                           "recording to align them)");
+        warnings.push_back(
+            "no words given: audio-only analysis (give the words spoken in the "
+            "recording to align them)");
     } else {
         try {
             aligned = alignText(speech, upload.path(), *text, voice, templates);

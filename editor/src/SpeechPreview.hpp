@@ -27,9 +27,8 @@ bool isVoiceName(const std::string& voice);
 // {"source": "espeak-ng", "schedule": [{start, end, phoneme}], "pairs": ["sil-f", ...],
 //  "weights": {"poses", "rate", "times", "values": [[per frame] per pose]}, "duration",
 //  "audio": "data:audio/wav;base64,...", "warnings": [...]}
-Preview renderPreview(EspeakSynthesizer& speech, const std::string& text,
-                                     const std::string& voice, const CharacterDraft& draft,
-                                     const lipsync::RuntimeConfig& runtime);
+Preview renderPreview(EspeakSynthesizer& speech, const std::string& text, const std::string& voice,
+                      const CharacterDraft& draft, const lipsync::RuntimeConfig& runtime);
 
 // The same for a recording (WAV, FLAC or OGG bytes): "source" is "aligned" when its words
 // (`text`) were placed by the known-script aligner, "audio-only" when no words were given or

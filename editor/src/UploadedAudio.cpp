@@ -36,8 +36,7 @@ void refuseTruncatedWav(const std::string& b) {
     for (std::uint64_t at = 12; at + 8 <= b.size();) {
         const std::uint32_t size = le32(b, at + 4);
         if (b.compare(at, 4, "data") == 0) {
-            if (!unknown(size) && at + 8 + size > b.size())
-                truncated("data chunk", at + 8 + size);
+            if (!unknown(size) && at + 8 + size > b.size()) truncated("data chunk", at + 8 + size);
             return;
         }
         at += 8 + std::uint64_t{size} + (size & 1);

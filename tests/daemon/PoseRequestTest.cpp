@@ -101,9 +101,9 @@ TEST(PoseRequest, BadWeightsAreRefusedByNameAndTheDaemonGoesOn) {
     EXPECT_EQ(unknown["ok"], false);
     EXPECT_NE(unknown.value("error", "").find("unknown pose 'grin'"), std::string::npos) << unknown;
     EXPECT_NE(unknown.value("error", "").find("jaw, open"), std::string::npos) << unknown;
-    for (const auto* line : {R"({"cmd":"pose","weights":{"jaw":NaN}})",
-                             R"({"cmd":"pose","weights":{"jaw":1e999}})",
-                             R"({"cmd":"pose","weights":[0.5]})"}) {
+    for (const auto* line :
+         {R"({"cmd":"pose","weights":{"jaw":NaN}})", R"({"cmd":"pose","weights":{"jaw":1e999}})",
+          R"({"cmd":"pose","weights":[0.5]})"}) {
         c.sendLine(line);
         const auto reply = json::parse(c.readLine(), nullptr, false);
         EXPECT_EQ(reply.value("ok", true), false) << line;

@@ -109,8 +109,8 @@ TEST(EditPuppet, TheServicesRefusalsReachTheUser) {
     d.start();
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
-    const auto wrong = runLipsync({"edit", "--socket", d.socket().string(), "--puppet", "crab",
-                                   "--port", "0", "--no-open"});
+    const auto wrong = runLipsync(
+        {"edit", "--socket", d.socket().string(), "--puppet", "crab", "--port", "0", "--no-open"});
     EXPECT_EQ(wrong.exitCode, 1);
     EXPECT_NE(wrong.err.find("lipsyncd drives the puppet 'terminal', not 'crab'"),
               std::string::npos)

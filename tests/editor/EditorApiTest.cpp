@@ -312,9 +312,9 @@ TEST(EditorApi, ABadRecordingIsAClear400AndNoPathIsEverOpened) {
         EXPECT_NE(errorOf(r).find(c.message), std::string::npos) << r.body;
         EXPECT_EQ(errorOf(r).find("/proc/"), std::string::npos) << r.body;
     }
-    EXPECT_EQ(e.call("POST", "/api/preview", json{{"wav", uploadOf(rec.wav)}, {"text", 3}}.dump())
-                  .status,
-              400);
+    EXPECT_EQ(
+        e.call("POST", "/api/preview", json{{"wav", uploadOf(rec.wav)}, {"text", 3}}.dump()).status,
+        400);
 }
 
 TEST(EditorApi, ARecordingOverTheLimitsIs413) {
@@ -344,8 +344,8 @@ TEST(EditorApi, PerformingNeedsAPuppet) {
 }
 
 TEST(EditorApi, Base64RoundTripsAndRefusesWhatIsNot) {
-    for (const auto& bytes : std::vector<std::string>{"", "a", "ab", "abc", "abcd",
-                                                      std::string("\0\xff\x10", 3)})
+    for (const auto& bytes :
+         std::vector<std::string>{"", "a", "ab", "abc", "abcd", std::string("\0\xff\x10", 3)})
         EXPECT_EQ(decodeBase64(encodeBase64(bytes)), bytes) << bytes;
     EXPECT_FALSE(decodeBase64("a"));
     EXPECT_FALSE(decodeBase64("ab c"));

@@ -188,9 +188,9 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
     // A recording with its words: picked in the page, sent as its bytes, aligned; it previews
     // the same way (schedule, curves, audio, the pairs it uses).
     const auto recording = dir / "what-fun.wav";
-    ASSERT_EQ(runLipsync({"say", kSentence, "--voice", "en-us+f2", "--wav", recording.string()})
-                  .exitCode,
-              0);
+    ASSERT_EQ(
+        runLipsync({"say", kSentence, "--voice", "en-us+f2", "--wav", recording.string()}).exitCode,
+        0);
     web.script("document.body.dataset.preview = ''; app.used = new Set(); paintGrid();");
     web.type("#recording", recording.string());
     web.type("#words", kSentence);
