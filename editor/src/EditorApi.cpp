@@ -268,7 +268,12 @@ ApiResponse EditorApi::perform(const ApiRequest& request) {
         return error(400, "stop: expected true or false");
     if (body.value("stop", false)) {
         puppet->stop();
-        return reply(200, ordered_json{{"puppet", puppet->puppet()}, {"playing", false}});
+        ordered_json j{{"puppet", puppet->puppet()},
+                       {"playing", false},
+                       {"frames_sent", puppet->framesSent()}};
+        // A stream the service stopped (a clip that started, the daemon gone) says why.
+        if (const auto why = puppet->lastError(); !why.empty()) j["stopped_early"] = why;
+        return reply(200, j);
     }
     const auto from = body.value("from", json(0.0));
     if (!from.is_number() || !(from.get<double>() >= 0) || !std::isfinite(from.get<double>()))
@@ -276,7 +281,9 @@ ApiResponse EditorApi::perform(const ApiRequest& request) {
     if (lastPreview_.frames() == 0) return error(409, "nothing to play: preview first");
     if (const auto refused = puppet->play(lastPreview_, from.get<double>()))
         return error(409, "lipsyncd: " + *refused);
-    return reply(200, ordered_json{{"puppet", puppet->puppet()}, {"playing", true}});
+    return reply(
+        200, ordered_json{
+                 {"puppet", puppet->puppet()}, {"playing", true}, {"lead", puppet->leadSeconds()}});
 }
 
 ApiResponse EditorApi::save() {

@@ -40,6 +40,10 @@ PuppetStream::PuppetStream(std::filesystem::path socket, const std::string& pupp
         throw InputError(socket_.string() +
                          ": not lipsyncd's control socket (status: " + status.dump() + ")");
     puppet_ = status["puppet"].get<std::string>();
+    // The servo's lag, from the puppet file: the daemon drives a clip's mouth this far ahead of
+    // its sound, and the stream does the same for the page's sound.
+    if (status.contains("latency") && status["latency"].value("lead", 0.0) > 0)
+        leadSeconds_ = status["latency"]["lead"].get<double>();
     if (!puppet.empty() && puppet != puppet_)
         throw InputError(socket_.string() + ": lipsyncd drives the puppet '" + puppet_ +
                          "', not '" + puppet + "' (--puppet)");
@@ -65,9 +69,10 @@ std::string PuppetStream::lastError() const {
 
 std::optional<std::string> PuppetStream::play(PoseTrack track, double fromSeconds) {
     stop();
-    const auto first = static_cast<std::size_t>(
-        std::lower_bound(track.times.begin(), track.times.end(), fromSeconds - 1e-9) -
-        track.times.begin());
+    const auto first =
+        static_cast<std::size_t>(std::lower_bound(track.times.begin(), track.times.end(),
+                                                  fromSeconds + leadSeconds_ - 1e-9) -
+                                 track.times.begin());
     if (first >= track.frames()) return std::nullopt;  // played to its end already
     {
         std::lock_guard lock(mutex_);
@@ -88,15 +93,16 @@ std::optional<std::string> PuppetStream::play(PoseTrack track, double fromSecond
     return std::nullopt;
 }
 
-// Frame f goes out when the page's audio reaches its time: the clock starts at `from`, where
-// the page started playing (play() has sent the frame there).
+// Frame f goes out the puppet's lead before the page's audio reaches its time: the clock
+// starts at `from`, where the page started playing (play() has sent the frame due then).
 void PuppetStream::stream(PoseTrack track, std::size_t next, double from) {
     const auto start = Clock::now();
     try {
         daemon::ControlClient client(socket_, kTimeout);
         for (std::size_t f = next; f < track.frames(); ++f) {
-            const auto due = start + std::chrono::duration_cast<Clock::duration>(
-                                         std::chrono::duration<double>(track.times[f] - from));
+            const auto due =
+                start + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double>(track.times[f] - leadSeconds_ - from));
             std::unique_lock lock(mutex_);
             if (wake_.wait_until(lock, due, [this] { return stopping_; })) return;
             lock.unlock();

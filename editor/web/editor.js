@@ -367,7 +367,9 @@ async function previewRecording(event) {
 // The puppet follows the page's audio: it starts where the audio starts and stops with it.
 function perform(body) {
   if (!app.info.puppet || !app.preview) return;
-  api('POST', '/api/perform', body).catch(showError);
+  api('POST', '/api/perform', body)
+    .then((r) => { if (r.stopped_early) showError(new Error('puppet: lipsyncd stopped the stream: ' + r.stopped_early)); })
+    .catch(showError);
 }
 
 function showPreview(p) {

@@ -127,14 +127,23 @@ TEST(EditPuppet, TheServicesRefusalsReachTheUser) {
     EXPECT_NE(e.post("/api/perform", {{"from", 0}}, 409)["error"].get<std::string>().find(
                   "preview first"),
               std::string::npos);
-    e.post("/api/preview", {{"text", "Hello."}});
+    // A clip that starts while the preview streams takes the mouth; the stream stops and the
+    // page hears why when it stops too.
+    e.post("/api/preview", {{"text", "Open wide, father, I am awake and ready to talk to you."}});
+    EXPECT_EQ(e.post("/api/perform", {{"from", 0}})["playing"], true);
     ASSERT_EQ(c.request({{"cmd", "say"}, {"text", "Hello hello hello hello hello."}})["ok"], true);
     ASSERT_TRUE(waitFor([&] { return !c.request({{"cmd", "status"}})["playing"].is_null(); }, 20));
+    std::this_thread::sleep_for(100ms);
+    const auto stopped = e.post("/api/perform", {{"stop", true}});
+    EXPECT_GT(stopped["frames_sent"].get<int>(), 0);
+    EXPECT_NE(stopped.value("stopped_early", "").find("refused while a clip plays"),
+              std::string::npos)
+        << stopped;
+    // Starting while the clip plays: refused at once, with the service's reason.
     const auto refused = e.post("/api/perform", {{"from", 0}}, 409);
     EXPECT_NE(refused["error"].get<std::string>().find("refused while a clip plays"),
               std::string::npos)
         << refused;
-    EXPECT_EQ(e.post("/api/perform", {{"stop", true}})["playing"], false);
     EXPECT_EQ(d.stop(), 0);
 }
 

@@ -106,7 +106,8 @@ struct ApiResponse {
 
 // The puppet that the running lipsyncd drives, moved by the preview: a thread sends the
 // weights of a preview to the control socket as `pose` requests, one per frame at the frames'
-// rate, from the moment the page starts playing the audio. The service applies them through
+// rate, from the moment the page starts playing the audio, each the puppet's lead early (as the
+// service drives a clip's mouth ahead of its sound). The service applies them through
 // the puppet's limits and slew and holds each briefly; when the stream stops, the mouth rests.
 class PuppetStream {
   public:
@@ -123,13 +124,15 @@ class PuppetStream {
     std::optional<std::string> play(PoseTrack track, double fromSeconds);
     void stop();
     const std::string& puppet() const { return puppet_; }
-    std::size_t framesSent() const { return sent_; }
+    double leadSeconds() const { return leadSeconds_; }  // the puppet's, as the service says
+    std::size_t framesSent() const { return sent_; }     // by the last play()
     std::string lastError() const;  // why the last stream stopped early ("" when it did not)
 
   private:
     void stream(PoseTrack track, std::size_t next, double from);
     std::filesystem::path socket_;
     std::string puppet_;
+    double leadSeconds_ = 0;
     std::atomic<std::size_t> sent_ = 0;
     mutable std::mutex mutex_;  // guards error_ and stopping_
     std::condition_variable wake_;
