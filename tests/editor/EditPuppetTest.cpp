@@ -4,6 +4,7 @@
 // (a clip playing, the wrong puppet, no daemon) reach the user as clear errors.
 #include <gtest/gtest.h>
 
+#include <lipsyncd/editor.hpp>
 #include <regex>
 
 #include "../daemon/DaemonProcess.hpp"
@@ -102,6 +103,29 @@ TEST(EditPuppet, ThePreviewMovesThePuppetTheServiceDrivesAndItRestsAfter) {
     std::cout << "puppet jaw against the preview's jaw: mean |difference| " << best << '\n';
     EXPECT_LT(best, 0.05) << "mean |puppet jaw − preview jaw| at the best lag";
     EXPECT_EQ(rec.back().second, 0.0) << "the jaw did not go back to rest after the preview";
+}
+
+// A puppet with a servo lag: the stream starts the lead into the preview and sends each frame
+// that much early, so the frames sent are exactly those from `from` + lead on.
+TEST(EditPuppet, TheStreamLeadsByThePuppetsLead) {
+    const auto dir = scratchDir("edit_puppet_lead");
+    auto puppet = slurp(findDataFile("puppets/terminal.toml"));
+    puppet.insert(puppet.find("\n[[actuator]]"), "\nlead = 0.2\n");
+    std::ofstream(dir / "laggy.toml") << puppet;
+    DaemonProcess d("", "null", (dir / "laggy.toml").string());
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    editor::PuppetStream stream(d.socket(), "");
+    EXPECT_DOUBLE_EQ(stream.leadSeconds(), 0.2);
+    PoseTrack track;
+    track.poses = {"jaw"};
+    for (int f = 0; f < 100; ++f) track.append(f / 100.0, std::vector<float>{f < 20 ? 0.0f : 0.5f});
+    ASSERT_FALSE(stream.play(track, 0.3));  // from 0.3 s: frames 50..99 (0.5 s and on)
+    std::this_thread::sleep_for(800ms);     // 0.5 s of frames, 0.2 s early
+    EXPECT_EQ(stream.framesSent(), 50u);
+    EXPECT_EQ(stream.lastError(), "");
+    EXPECT_EQ(d.stop(), 0);
 }
 
 TEST(EditPuppet, TheServicesRefusalsReachTheUser) {
