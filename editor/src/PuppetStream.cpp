@@ -69,17 +69,18 @@ std::string PuppetStream::lastError() const {
 
 std::optional<std::string> PuppetStream::play(PoseTrack track, double fromSeconds) {
     stop();
-    const auto first =
-        static_cast<std::size_t>(std::lower_bound(track.times.begin(), track.times.end(),
-                                                  fromSeconds + leadSeconds_ - 1e-9) -
-                                 track.times.begin());
-    if (first >= track.frames()) return std::nullopt;  // played to its end already
+    const auto start = Clock::now();  // the page's audio is at `fromSeconds` now
     {
         std::lock_guard lock(mutex_);
         stopping_ = false;
         error_.clear();
     }
     sent_ = 0;
+    const auto first =
+        static_cast<std::size_t>(std::lower_bound(track.times.begin(), track.times.end(),
+                                                  fromSeconds + leadSeconds_ - 1e-9) -
+                                 track.times.begin());
+    if (first >= track.frames()) return std::nullopt;  // played to its end already
     try {
         daemon::ControlClient client(socket_, kTimeout);
         if (auto refused = refusal(client.request(poseRequest(track, first)))) return refused;
@@ -87,16 +88,16 @@ std::optional<std::string> PuppetStream::play(PoseTrack track, double fromSecond
         return std::string(e.what());
     }
     ++sent_;
-    thread_ = std::thread([this, t = std::move(track), first, fromSeconds]() mutable {
-        stream(std::move(t), first + 1, fromSeconds);
+    thread_ = std::thread([this, t = std::move(track), first, start, fromSeconds]() mutable {
+        stream(std::move(t), first + 1, start, fromSeconds);
     });
     return std::nullopt;
 }
 
 // Frame f goes out the puppet's lead before the page's audio reaches its time: the clock
-// starts at `from`, where the page started playing (play() has sent the frame due then).
-void PuppetStream::stream(PoseTrack track, std::size_t next, double from) {
-    const auto start = Clock::now();
+// was at `from` at `start`, when the page started playing (play() has sent the frame due then).
+void PuppetStream::stream(PoseTrack track, std::size_t next,
+                          std::chrono::steady_clock::time_point start, double from) {
     try {
         daemon::ControlClient client(socket_, kTimeout);
         for (std::size_t f = next; f < track.frames(); ++f) {

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <filesystem>
 #include <lipsyncd/core.hpp>
@@ -129,7 +130,8 @@ class PuppetStream {
     std::string lastError() const;  // why the last stream stopped early ("" when it did not)
 
   private:
-    void stream(PoseTrack track, std::size_t next, double from);
+    void stream(PoseTrack track, std::size_t next, std::chrono::steady_clock::time_point start,
+                double from);
     std::filesystem::path socket_;
     std::string puppet_;
     double leadSeconds_ = 0;
