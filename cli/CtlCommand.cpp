@@ -48,8 +48,29 @@ nlohmann::json valueOf(const ControlArg& arg, const std::string& word) {
             return std::filesystem::absolute(word).string();
         case ControlArg::Type::String:
             return word;
+        case ControlArg::Type::Weights:
+            break;  // several words: weightsOf
     }
     throw CLI::ValidationError("ctl", "'" + word + "' is not " + std::string(arg.help));
+}
+
+// NAME=VALUE words as a weights object: `lipsync ctl pose jaw=0.5 open=0.2`.
+nlohmann::json weightsOf(const ControlArg& arg, std::span<const std::string> words) {
+    nlohmann::json weights = nlohmann::json::object();
+    for (const auto& word : words) {
+        const auto eq = word.find('=');
+        std::size_t used = 0;
+        double value = 0;
+        try {
+            if (eq != std::string::npos) value = std::stod(word.substr(eq + 1), &used);
+        } catch (const std::exception&) {
+        }
+        if (eq == std::string::npos || eq == 0 || used == 0 || eq + 1 + used != word.size())
+            throw CLI::ValidationError(
+                "ctl", "'" + word + "' is not NAME=VALUE: " + std::string(arg.help));
+        weights[word.substr(0, eq)] = value;
+    }
+    return weights;
 }
 
 nlohmann::json requestFrom(const CtlOptions& o) {
@@ -72,6 +93,8 @@ nlohmann::json requestFrom(const CtlOptions& o) {
             std::string text;
             for (std::size_t i = 1; i < a.size(); ++i) text += (i > 1 ? " " : "") + a[i];
             r[arg.name] = text;
+        } else if (arg.type == ControlArg::Type::Weights) {
+            r[arg.name] = weightsOf(arg, std::span<const std::string>(a).subspan(1));
         } else if (a.size() == 2) {
             r[arg.name] = valueOf(arg, a[1]);
         } else {

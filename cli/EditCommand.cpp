@@ -19,6 +19,7 @@ struct EditOptions {
     std::string poses = "facefx";
     std::string phonemes = "common";
     std::string voice = "en-us";
+    std::string socket, puppet;
     editor::ServerOptions server;
     bool noOpen = false;
 };
@@ -52,9 +53,16 @@ void runEdit(const EditOptions& o) {
     auto poses = lipsync::PoseSet::named(o.poses);
     auto mouth = editor::MouthDrawing::load(findDataFile("editor/mouth.toml"), poses);
     editor::CharacterDraft draft(std::move(poses), phonemes, o.curves, o.character);
+    if (!o.puppet.empty() && o.socket.empty())
+        throw CLI::ValidationError("--puppet", "names the puppet lipsyncd drives: give --socket");
+    std::optional<editor::PuppetStream> puppet;
+    if (!o.socket.empty()) puppet.emplace(o.socket, o.puppet);
     EspeakSynthesizer speech;
+    editor::PreviewSettings preview;
+    preview.voice = o.voice;
+    preview.puppet = puppet ? &*puppet : nullptr;
     editor::EditorApi api(std::move(draft), std::move(mouth), editor::randomToken(), speech,
-                          {o.voice, lipsync::RuntimeConfig{}});
+                          preview);
 
     editor::EditorServer server(api, o.server);
     if (!isLoopback(o.server.bind))
@@ -63,6 +71,9 @@ void runEdit(const EditOptions& o) {
     std::cout << "lipsync edit: " << server.url() << '\n'
               << "lipsync edit: "
               << (o.character.empty() ? "no --character: saving is off" : "saves to " + o.character)
+              << (puppet ? "; the preview moves '" + puppet->puppet() + "' (lipsyncd, " + o.socket +
+                               ")"
+                         : std::string())
               << "; Ctrl-C stops" << std::endl;
     if (!o.noOpen) openInBrowser(server.url());
     std::thread watcher([&] {
@@ -79,7 +90,9 @@ void runEdit(const EditOptions& o) {
 void addEditCommand(CLI::App& app) {
     auto o = std::make_shared<EditOptions>();
     auto* cmd = app.add_subcommand(
-        "edit", "Edit bigram curves in a browser: drag control points, hear and see a sentence");
+        "edit",
+        "Edit bigram curves in a browser: drag control points, hear and see a sentence or a "
+        "recording with its words (and, with --socket, the puppet lipsyncd drives)");
     cmd->add_option("--curves", o->curves, "Base curve set (config/curves/NAME.json, or a file)")
         ->capture_default_str();
     cmd->add_option("--character", o->character,
@@ -89,7 +102,13 @@ void addEditCommand(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--phonemes", o->phonemes, "Phoneme set: common, mandarin, or a file")
         ->capture_default_str();
-    cmd->add_option("--voice", o->voice, "espeak-ng voice for the preview")->capture_default_str();
+    cmd->add_option("--voice", o->voice,
+                    "espeak-ng voice for the preview (and for reading a recording's words)")
+        ->capture_default_str();
+    cmd->add_option("--socket", o->socket,
+                    "lipsyncd's control socket: the preview moves the puppet it drives too");
+    cmd->add_option("--puppet", o->puppet,
+                    "With --socket: the puppet lipsyncd must be driving (refused otherwise)");
     cmd->add_option("--port", o->server.port, "TCP port (0: any free one)")
         ->check(CLI::Range(0, 65535))
         ->capture_default_str();

@@ -3,6 +3,7 @@
 // (MPD keeps its commands the same way: one sorted table with argument counts checked in one
 // place.) A refused request names the command and the argument.
 #include <algorithm>
+#include <cmath>
 #include <lipsyncd/daemon.hpp>
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,7 @@ using Type = ControlArg::Type;
 constexpr std::size_t kMaxPath = 4096;
 constexpr std::size_t kMaxText = 16384;
 constexpr std::size_t kMaxVoice = 64;
+constexpr std::size_t kMaxPoses = 64;
 
 constexpr ControlArg kPlayArgs[] = {
     {"file", Type::Path, true, kMaxPath, 0, 0, "the audio file (WAV, FLAC, OGG), a regular file"},
@@ -25,6 +27,10 @@ constexpr ControlArg kSayArgs[] = {
     {"text", Type::String, true, kMaxText, 0, 0, "what to say"},
     {"voice", Type::String, false, kMaxVoice, 0, 0, "an espeak-ng voice"},
 };
+constexpr ControlArg kPoseArgs[] = {
+    {"weights", Type::Weights, true, kMaxPoses, 0, 1,
+     "pose weights, NAME=VALUE each within 0..1 (poses not named: 0)"},
+};
 constexpr ControlArg kOnArg[] = {
     {"on", Type::Boolean, false, 0, 0, 0, "on or off (default on)"},
 };
@@ -32,6 +38,8 @@ constexpr ControlArg kOnArg[] = {
 constexpr ControlCommand kCommands[] = {
     {"live", "live on|off: follow the microphone", "on", kOnArg},
     {"play", "play FILE: queue an audio file", "file", kPlayArgs},
+    {"pose", "pose NAME=WEIGHT...: hold the mouth in a pose for 0.25 s (not while a clip plays)",
+     "weights", kPoseArgs},
     {"queue", "queue: what plays and what waits (as status)", "", {}},
     {"reload", "reload: read the configuration again (as SIGHUP)", "", {}},
     {"say", "say TEXT: queue speech", "text", kSayArgs},
@@ -46,9 +54,28 @@ std::string typeName(Type t) {
             return "true or false";
         case Type::Integer:
             return "an integer";
+        case Type::Weights:
+            return "an object of pose weights";
         default:
             return "a string";
     }
+}
+
+// {"jaw": 0.4, ...}: JSON has no NaN, but a number too large for a double parses as infinity.
+std::optional<std::string> checkWeights(const std::string& where, const ControlArg& a,
+                                        const nlohmann::json& v) {
+    if (!v.is_object()) return where + "must be an object of pose weights, {\"NAME\": 0.5}";
+    if (v.size() > a.maxLength)
+        return where + "has more than " + std::to_string(a.maxLength) + " poses";
+    for (const auto& [name, w] : v.items()) {
+        if (name.empty() || name.size() > 64) return where + "has a pose name of 0 or > 64 bytes";
+        const auto at = where.substr(0, where.size() - 1) + ".\"" + name + "\" ";
+        if (!w.is_number() || !std::isfinite(w.get<double>()) || w.get<double>() < a.min ||
+            w.get<double>() > a.max)
+            return at + "must be a number within " + std::to_string(a.min) + " .. " +
+                   std::to_string(a.max);
+    }
+    return std::nullopt;
 }
 
 std::optional<std::string> checkArg(const ControlCommand& c, const ControlArg& a,
@@ -71,6 +98,8 @@ std::optional<std::string> checkArg(const ControlCommand& c, const ControlArg& a
             if (a.required && v.get_ref<const std::string&>().empty())
                 return where + "must not be empty";
             return std::nullopt;
+        case Type::Weights:
+            return checkWeights(where, a, v);
     }
     return std::nullopt;
 }

@@ -64,6 +64,7 @@ void Daemon::Impl::tick() {
     if (!player.clip())
         if (auto clip = queue.tryTakeReady()) {
             player.start(std::move(*clip), *setup->audio);
+            heldPose.release();  // the clip has the mouth now
             status("playing " + player.clip()->name);
         }
     const auto& config = setup->config;
@@ -75,6 +76,8 @@ void Daemon::Impl::tick() {
         liveFrame.empty() ? driver.tick(t) : driver.update(t, liveFrame);
     } else if (!clipFrame.empty()) {
         driver.update(t, clipFrame);
+    } else if (const auto pose = heldPose.at(t); !pose.empty()) {
+        driver.update(t, pose);  // a client's pose (`pose`), through the same limits and slew
     } else {
         driver.tick(t);  // idle: the mouth rests once input has stalled
     }

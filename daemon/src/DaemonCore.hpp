@@ -10,6 +10,7 @@
 #include "ControlServer.hpp"
 #include "LiveMode.hpp"
 #include "Player.hpp"
+#include "PoseHold.hpp"
 #include "Setup.hpp"
 
 namespace lipsyncd::daemon {
@@ -25,6 +26,8 @@ struct Daemon::Impl {
     ClipQueue queue{8};
     Player player;
     std::optional<LiveMode> live;
+    PoseHold heldPose;               // PoseRequest.cpp
+    std::vector<float> poseWeights;  // the request's weights, in the clip maker's pose order
     double start = 0;
     double lastEvent = 0, lastWatchdog = 0;
     std::uint64_t watchdogUsec = 0;
@@ -44,6 +47,7 @@ struct Daemon::Impl {
     nlohmann::json say(const nlohmann::json& request);
     nlohmann::json stop();
     nlohmann::json setLive(bool on);
+    nlohmann::json holdPose(const nlohmann::json& request);  // PoseRequest.cpp
 
     // Events.cpp
     nlohmann::json frameEvent(double t) const;

@@ -21,6 +21,7 @@ json Daemon::Impl::handle(const json& r) {
             return {{"ok", true}, {"config", configFile.string()}};
         }
         if (cmd == "live") return setLive(r.value("on", true));
+        if (cmd == "pose") return holdPose(r);
         return {{"ok", false}, {"error", cmd + ": only on a connection (subscribe)"}};
     } catch (const std::exception& e) {
         return {{"ok", false}, {"error", e.what()}};
@@ -66,6 +67,7 @@ json Daemon::Impl::say(const json& r) {
 json Daemon::Impl::stop() {
     queue.clear();
     player.stop(*setup->audio);
+    heldPose.release();
     status("stopped; idle");
     return {{"ok", true}};
 }

@@ -58,10 +58,15 @@ ordered_json points(std::span<const lipsync::ControlPoint> polygon) {
     return out;
 }
 
+// A request the API cannot even read: 400, where input it reads and refuses is 422.
+struct MalformedRequest : InputError {
+    using InputError::InputError;
+};
+
 json parseBody(const std::string& body) {
     auto j = json::parse(body, nullptr, false);
     if (j.is_discarded() || !j.is_object())
-        throw InputError("request body: expected a JSON object");
+        throw MalformedRequest("request body: expected a JSON object");
     return j;
 }
 }  // namespace
@@ -80,6 +85,8 @@ ApiResponse EditorApi::handle(const ApiRequest& request) {
     std::lock_guard lock(mutex_);
     try {
         return route(request);
+    } catch (const MalformedRequest& e) {
+        return error(400, e.what());
     } catch (const InputError& e) {
         return error(422, e.what());
     } catch (const std::exception& e) {
@@ -106,8 +113,10 @@ ApiResponse EditorApi::route(const ApiRequest& request) {
         if (m == "PUT") return putBigram(a, b, request);
         return error(405, "GET or PUT /api/bigrams/FIRST/SECOND only");
     }
-    if (parts.size() == 2 && (parts[1] == "preview" || parts[1] == "save")) {
+    if (parts.size() == 2 &&
+        (parts[1] == "preview" || parts[1] == "save" || parts[1] == "perform")) {
         if (m != "POST") return error(405, "POST /api/" + parts[1] + " only");
+        if (parts[1] == "perform") return perform(request);
         return parts[1] == "preview" ? preview(request) : save();
     }
     return error(404, "no such call: " + request.path);
@@ -123,6 +132,8 @@ ApiResponse EditorApi::listBigrams() const {
     j["character"] = draft_.characterFile().string();
     j["base"] = draft_.baseName();
     j["unsaved"] = draft_.unsaved();
+    j["puppet"] =
+        settings_.puppet ? ordered_json(settings_.puppet->puppet()) : ordered_json(nullptr);
     auto& mouth = j["mouth"];
     mouth["parameters"] = mouth_.parameters;
     mouth["neutral"] = mouth_.neutral;
@@ -161,12 +172,7 @@ ApiResponse EditorApi::bigram(std::size_t first, std::size_t second) const {
 }
 
 ApiResponse EditorApi::putBigram(std::size_t first, std::size_t second, const ApiRequest& request) {
-    json body;
-    try {
-        body = parseBody(request.body);
-    } catch (const InputError& e) {
-        return error(400, e.what());
-    }
+    const auto body = parseBody(request.body);
     if (!body.contains("poses") || !body["poses"].is_object())
         return error(400, "request body: expected {\"poses\": {\"POSE\": [[t, v], ...], ...}}");
     draft_.replace(
@@ -176,22 +182,7 @@ ApiResponse EditorApi::putBigram(std::size_t first, std::size_t second, const Ap
 }
 
 ApiResponse EditorApi::preview(const ApiRequest& request) {
-    json body;
-    try {
-        body = parseBody(request.body);
-    } catch (const InputError& e) {
-        return error(400, e.what());
-    }
-    if (body.contains("wav"))
-        return error(400,
-                     "previewing a recording needs the known-script aligner, which this "
-                     "build lacks: preview with {\"text\": ...}");
-    if (!body.contains("text") || !body["text"].is_string() ||
-        body["text"].get<std::string>().empty())
-        return error(400, "request body: expected {\"text\": \"a sentence\"}");
-    const auto text = body["text"].get<std::string>();
-    if (text.size() > kMaxTextLength)
-        return error(400, "text: at most " + std::to_string(kMaxTextLength) + " bytes");
+    const auto body = parseBody(request.body);
     auto voice = settings_.voice;
     if (body.contains("voice")) {
         if (!body["voice"].is_string() || !isVoiceName(body["voice"].get<std::string>()))
@@ -209,7 +200,90 @@ ApiResponse EditorApi::preview(const ApiRequest& request) {
                 return error(400, std::string(key) + ": expected true or false");
             *flag = body[key].get<bool>();
         }
-    return reply(200, renderPreview(*speech_, text, voice, draft_, runtime));
+    if (body.contains("wav")) return previewRecording(body, voice, runtime);
+    if (!body.contains("text") || !body["text"].is_string() ||
+        body["text"].get<std::string>().empty())
+        return error(400,
+                     "request body: expected {\"text\": \"a sentence\"} or {\"wav\": "
+                     "\"data:audio/wav;base64,...\", \"text\": \"its words\"}");
+    const auto text = body["text"].get<std::string>();
+    if (text.size() > kMaxTextLength)
+        return error(400, "text: at most " + std::to_string(kMaxTextLength) + " bytes");
+    auto p = renderPreview(*speech_, text, voice, draft_, runtime);
+    lastPreview_ = std::move(p.weights);
+    return reply(200, p.reply);
+}
+
+// {"wav": base64 or a data: URI of the file's bytes, "text": the words (optional)}. The bytes
+// come in the request: a path in it would be a file the editor opens for a web page.
+ApiResponse EditorApi::previewRecording(const json& body, const std::string& voice,
+                                        const lipsync::RuntimeConfig& runtime) {
+    if (!body["wav"].is_string())
+        return error(400,
+                     "wav: expected the file's bytes in base64 (\"data:audio/wav;base64,"
+                     "...\"), not a path");
+    const auto& encoded = body["wav"].get_ref<const std::string&>();
+    // Base64 grows 3 bytes to 4; a data: URI's head is short.
+    if (encoded.size() > settings_.maxUploadBytes / 3 * 4 + 64)
+        return error(413, "wav: more than " + std::to_string(settings_.maxUploadBytes >> 20) +
+                              " MiB; preview a shorter recording");
+    const auto bytes = decodeBase64(encoded);
+    if (!bytes)
+        return error(400,
+                     "wav: not base64 (expected \"data:audio/wav;base64,...\" or the "
+                     "base64 of the file)");
+    if (bytes->empty()) return error(400, "wav: empty");
+    std::optional<std::string> text;
+    if (body.contains("text")) {
+        if (!body["text"].is_string())
+            return error(400, "text: the words spoken in the recording, as a string");
+        if (body["text"].get<std::string>().size() > kMaxTextLength)
+            return error(400, "text: at most " + std::to_string(kMaxTextLength) + " bytes");
+        if (!body["text"].get<std::string>().empty()) text = body["text"].get<std::string>();
+    }
+    espeakMapForVoice(voice);  // an unknown language is the request's error, not a fallback
+    if (!templates_)
+        templates_ = settings_.templates.empty() ? dsp::TemplateSet::loadDefault()
+                                                 : dsp::TemplateSet::load(settings_.templates);
+    try {
+        auto p = renderRecordingPreview(*speech_, *templates_, *bytes, text, voice,
+                                        settings_.maxRecordingSeconds, draft_, runtime);
+        lastPreview_ = std::move(p.weights);
+        return reply(200, p.reply);
+    } catch (const TooLarge& e) {
+        return error(413, e.what());
+    } catch (const InputError& e) {
+        return error(400, e.what());
+    }
+}
+
+// {"from": seconds} when the page starts playing the preview's audio (from there), {"stop":
+// true} when it pauses: the puppet follows the page.
+ApiResponse EditorApi::perform(const ApiRequest& request) {
+    const auto body = parseBody(request.body);
+    auto* puppet = settings_.puppet;
+    if (!puppet)
+        return error(409, "no puppet: start `lipsync edit --socket PATH` with lipsyncd running");
+    if (body.contains("stop") && !body["stop"].is_boolean())
+        return error(400, "stop: expected true or false");
+    if (body.value("stop", false)) {
+        puppet->stop();
+        ordered_json j{{"puppet", puppet->puppet()},
+                       {"playing", false},
+                       {"frames_sent", puppet->framesSent()}};
+        // A stream the service stopped (a clip that started, the daemon gone) says why.
+        if (const auto why = puppet->lastError(); !why.empty()) j["stopped_early"] = why;
+        return reply(200, j);
+    }
+    const auto from = body.value("from", json(0.0));
+    if (!from.is_number() || !(from.get<double>() >= 0) || !std::isfinite(from.get<double>()))
+        return error(400, "from: seconds into the preview, a number ≥ 0");
+    if (lastPreview_.frames() == 0) return error(409, "nothing to play: preview first");
+    if (const auto refused = puppet->play(lastPreview_, from.get<double>()))
+        return error(409, "lipsyncd: " + *refused);
+    return reply(
+        200, ordered_json{
+                 {"puppet", puppet->puppet()}, {"playing", true}, {"lead", puppet->leadSeconds()}});
 }
 
 ApiResponse EditorApi::save() {

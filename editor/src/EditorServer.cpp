@@ -12,7 +12,9 @@ struct EditorServer::Impl {
 };
 
 namespace {
-constexpr std::size_t kMaxBody = 1 << 20;  // a bigram's curves or a sentence: far less
+// A bigram's curves or a sentence: far less; a recording's preview: its bytes in base64 (the
+// API's own limit, PreviewSettings::maxUploadBytes, answers with the figures below this).
+constexpr std::size_t kMaxBody = 16u << 20;
 
 void serveApi(EditorApi& api, const httplib::Request& req, httplib::Response& res) {
     ApiRequest r{req.method, req.path, req.get_header_value("X-Lipsync-Token"), req.body};
@@ -43,6 +45,22 @@ EditorServer::EditorServer(EditorApi& api, const ServerOptions& options)
                            {"Content-Security-Policy",
                             "default-src 'self'; media-src 'self' data:; img-src 'self' data:"}});
     s.set_payload_max_length(kMaxBody);
+    s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req,
+                                                                httplib::Response& res) {
+        // The server's own refusal of a body over kMaxBody comes without one; the API's
+        // answers keep theirs.
+        if (res.status != 413 || !res.body.empty())
+            return httplib::Server::HandlerResponse::Unhandled;
+        // cpp-httplib takes only 8 KiB of a body it thinks is a form (curl's default type).
+        const bool form =
+            req.get_header_value("Content-Type") == "application/x-www-form-urlencoded";
+        res.set_content(form ? R"({"error": "send the JSON with Content-Type: application/json"})"
+                             : R"({"error": "request larger than )" +
+                                   std::to_string(kMaxBody >> 20) +
+                                   R"( MiB: preview a shorter recording"})",
+                        "application/json");
+        return httplib::Server::HandlerResponse::Handled;
+    }));
     // cpp-httplib's default adds SO_REUSEPORT, which lets a second editor share the port and
     // take half the requests: only SO_REUSEADDR, so a busy port is an error.
     s.set_socket_options([](int sock) {

@@ -1,4 +1,5 @@
-// Preview of a typed sentence, as `lipsync say --weights` computes it, on the unsaved curves.
+// Preview of a typed sentence, as `lipsync say --weights` computes it, on the unsaved curves;
+// the reply's form, which a recording's preview shares.
 #include "SpeechPreview.hpp"
 
 #include <algorithm>
@@ -47,24 +48,33 @@ bool isVoiceName(const std::string& voice) {
            });
 }
 
-ordered_json renderPreview(EspeakSynthesizer& speech, const std::string& text,
-                           const std::string& voice, const CharacterDraft& draft,
-                           const lipsync::RuntimeConfig& runtime) {
-    const auto spoken = speech.synthesize({text, voice});
-    std::vector<std::string> warnings;
-    const auto schedule = mapSchedule(spoken.phonemes, espeakMapForVoice(voice), &warnings);
-    const auto track =
+Preview makePreview(const std::string& source, const PhonemeSchedule& schedule,
+                    std::span<const std::int16_t> samples, int sampleRate,
+                    const CharacterDraft& draft, const lipsync::RuntimeConfig& runtime,
+                    const std::vector<std::string>& warnings) {
+    Preview p;
+    p.weights =
         lipsync::animate(schedule, draft.curves(), draft.poses(), runtime, draft.phonemes());
-    ordered_json j;
+    auto& j = p.reply;
+    j["source"] = source;
     auto& segments = j["schedule"] = ordered_json::array();
     for (const auto& s : schedule)
         segments.push_back({{"start", s.start}, {"end", s.end}, {"phoneme", s.phoneme}});
     j["pairs"] = pairsOf(schedule);
-    j["weights"] = weightsJson(track, runtime.outputRate);
-    j["duration"] = static_cast<double>(spoken.samples.size()) / spoken.sampleRate;
-    j["audio"] = wavDataUri(spoken.samples, spoken.sampleRate);
+    j["weights"] = weightsJson(p.weights, runtime.outputRate);
+    j["duration"] = static_cast<double>(samples.size()) / sampleRate;
+    j["audio"] = wavDataUri(samples, sampleRate);
     j["warnings"] = warnings;
-    return j;
+    return p;
+}
+
+Preview renderPreview(EspeakSynthesizer& speech, const std::string& text, const std::string& voice,
+                      const CharacterDraft& draft, const lipsync::RuntimeConfig& runtime) {
+    const auto spoken = speech.synthesize({text, voice});
+    std::vector<std::string> warnings;
+    const auto schedule = mapSchedule(spoken.phonemes, espeakMapForVoice(voice), &warnings);
+    return makePreview("espeak-ng", schedule, spoken.samples, spoken.sampleRate, draft, runtime,
+                       warnings);
 }
 
 }  // namespace lipsyncd::editor

@@ -330,15 +330,49 @@ async function save() {
 
 // ---- preview -------------------------------------------------------------------------------
 
-async function preview(event) {
-  event.preventDefault();
-  setStatus('speaking\u2026');
-  const p = await api('POST', '/api/preview', {
-    text: $('sentence').value,
+function runtimeSteps() {
+  return {
     smoothing: $('step-smoothing').checked,
     constraints: $('step-constraints').checked,
     speed_limits: $('step-speed').checked,
+  };
+}
+
+async function preview(event) {
+  event.preventDefault();
+  setStatus('speaking\u2026');
+  showPreview(await api('POST', '/api/preview', { text: $('sentence').value, ...runtimeSteps() }));
+}
+
+function readAsDataUrl(file) {
+  return new Promise((resolve, reject) => {
+    const reader = new FileReader();
+    reader.onload = () => resolve(reader.result);
+    reader.onerror = () => reject(reader.error);
+    reader.readAsDataURL(file);
   });
+}
+
+// A recording goes up as its bytes (a data: URI in the JSON): the editor never opens a path.
+async function previewRecording(event) {
+  event.preventDefault();
+  const file = $('recording').files[0];
+  if (!file) throw new Error('pick a recording (WAV, FLAC or OGG) first');
+  setStatus(($('words').value.trim() ? 'aligning ' : 'analysing ') + file.name + '\u2026');
+  const body = { wav: await readAsDataUrl(file), ...runtimeSteps() };
+  if ($('words').value.trim()) body.text = $('words').value;
+  showPreview(await api('POST', '/api/preview', body));
+}
+
+// The puppet follows the page's audio: it starts where the audio starts and stops with it.
+function perform(body) {
+  if (!app.info.puppet || !app.preview) return;
+  api('POST', '/api/perform', body)
+    .then((r) => { if (r.stopped_early) showError(new Error('puppet: lipsyncd stopped the stream: ' + r.stopped_early)); })
+    .catch(showError);
+}
+
+function showPreview(p) {
   app.preview = p;
   app.used = new Set(p.pairs);
   paintGrid();
@@ -348,8 +382,10 @@ async function preview(event) {
   audio.currentTime = 0;
   drawCursor(0);
   audio.play().catch(() => {});  // no sound device: the cursor still follows seeking
-  setStatus('preview: ' + p.schedule.length + ' phonemes, ' + p.duration.toFixed(2) + ' s');
+  const how = { 'espeak-ng': '', aligned: ', words aligned', 'audio-only': ', audio-only analysis' };
+  setStatus('preview: ' + p.schedule.length + ' phonemes, ' + p.duration.toFixed(2) + ' s' + how[p.source]);
   document.body.dataset.preview = 'ready';
+  document.body.dataset.source = p.source;
   showError(p.warnings.length ? p.warnings.join('\n') : null);
 }
 
@@ -491,8 +527,17 @@ async function start() {
   for (const id of ['point-time', 'point-value'])
     $(id).addEventListener('keydown', (e) => { if (e.key === 'Enter') setPoint(); });
   $('preview-form').addEventListener('submit', (e) => preview(e).catch(showError));
-  $('audio').addEventListener('play', () => requestAnimationFrame(followAudio));
-  $('audio').addEventListener('seeked', () => drawCursor($('audio').currentTime));
+  $('recording-form').addEventListener('submit', (e) => previewRecording(e).catch(showError));
+  $('puppet').textContent = app.info.puppet ? 'moves the puppet \u2018' + app.info.puppet + '\u2019' : '';
+  $('audio').addEventListener('play', () => {
+    perform({ from: $('audio').currentTime });
+    requestAnimationFrame(followAudio);
+  });
+  $('audio').addEventListener('pause', () => perform({ stop: true }));
+  $('audio').addEventListener('seeked', () => {
+    drawCursor($('audio').currentTime);
+    if (!$('audio').paused) perform({ from: $('audio').currentTime });
+  });
   $('timeline').addEventListener('click', seek);
   document.addEventListener('keydown', (e) => {
     if (!(e.ctrlKey || e.metaKey) || e.target.tagName === 'INPUT') return;

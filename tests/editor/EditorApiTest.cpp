@@ -8,6 +8,7 @@
 #include <lipsyncd/editor.hpp>
 #include <nlohmann/json.hpp>
 
+#include "../../editor/src/SpeechPreview.hpp"  // wavDataUri, encodeBase64, decodeBase64
 #include "../cli/RunLipsync.hpp"
 
 namespace lipsyncd::editor {
@@ -25,11 +26,13 @@ struct Editor {
     std::filesystem::path character;
     std::unique_ptr<EditorApi> api;
 
-    explicit Editor(const std::filesystem::path& file) : character(file) {
+    explicit Editor(const std::filesystem::path& file, const PreviewSettings& settings = {})
+        : character(file) {
         auto poses = lipsync::PoseSet::named("facefx");
         auto mouth = MouthDrawing::load(findDataFile("editor/mouth.toml"), poses);
         CharacterDraft draft(std::move(poses), PhonemeSet::common(), "english", file);
-        api = std::make_unique<EditorApi>(std::move(draft), std::move(mouth), "secret", speech());
+        api = std::make_unique<EditorApi>(std::move(draft), std::move(mouth), "secret", speech(),
+                                          settings);
     }
     ApiResponse call(const std::string& method, const std::string& path,
                      const std::string& body = "", const std::string& token = "secret") {
@@ -213,11 +216,140 @@ TEST(EditorApi, PreviewRejectsWhatItCannotDoClearly) {
     EXPECT_EQ(e.call("POST", "/api/preview", R"({"text": ""})").status, 400);
     EXPECT_EQ(e.call("POST", "/api/preview", R"({"text": "hi", "voice": "../../x"})").status, 400);
     EXPECT_EQ(e.call("POST", "/api/preview", R"({"text": "hi", "voice": "zz-nope"})").status, 422);
-    const auto wav = e.call("POST", "/api/preview", R"({"wav": "/etc/passwd"})");
-    EXPECT_EQ(wav.status, 400);
-    EXPECT_NE(errorOf(wav).find("aligner"), std::string::npos);
     EXPECT_EQ(e.call("POST", "/api/preview", R"({"text": "hi", "constraints": "no"})").status, 400);
     EXPECT_EQ(e.call("GET", "/api/preview").status, 405);
+}
+
+// A recording as the page sends it: the file's bytes in a data: URI, made here from speech.
+struct Recording {
+    std::string wav;  // the file's bytes
+    double seconds = 0;
+};
+Recording recordingOf(const std::string& text) {
+    const auto spoken = speech().synthesize({text, "en-us"});
+    const auto uri = wavDataUri(spoken.samples, spoken.sampleRate);
+    return {*decodeBase64(uri), static_cast<double>(spoken.samples.size()) / spoken.sampleRate};
+}
+std::string uploadOf(const std::string& bytes) {
+    return "data:audio/wav;base64," + encodeBase64(bytes);
+}
+
+std::vector<std::string> phonemesOf(const json& preview) {
+    std::vector<std::string> out;
+    for (const auto& s : preview["schedule"]) out.push_back(s["phoneme"]);
+    return out;
+}
+bool has(const std::vector<std::string>& list, const std::string& item) {
+    return std::find(list.begin(), list.end(), item) != list.end();
+}
+
+TEST(EditorApi, ARecordingWithItsWordsIsAlignedAndAnimatedLikeTypedText) {
+    const auto dir = scratchDir("editor_recording");
+    Editor e(dir / "crab.json");
+    const auto rec = recordingOf("Fine fast father");
+    const auto r = e.call("POST", "/api/preview",
+                          json{{"wav", uploadOf(rec.wav)}, {"text", "Fine fast father"}}.dump());
+    ASSERT_EQ(r.status, 200) << r.body.substr(0, 400);
+    const auto p = body(r);
+    EXPECT_EQ(p["source"], "aligned") << p["warnings"];
+    ASSERT_EQ(p["words"].size(), 3u);
+    for (const auto& w : p["words"]) EXPECT_TRUE(w["placed"].get<bool>()) << w;
+    EXPECT_LT(p["words"][0]["start"].get<double>(), p["words"][2]["start"].get<double>());
+    // The words' phonemes in the common set's classes (fine: f ay d; fast: f ah z d; father:
+    // f aa th er).
+    const auto phonemes = phonemesOf(p);
+    for (const auto* ph : {"f", "ay", "d", "z", "aa", "th"}) EXPECT_TRUE(has(phonemes, ph)) << ph;
+    EXPECT_EQ(std::count(phonemes.begin(), phonemes.end(), "f"), 3) << json(phonemes);
+    const auto pairs = p["pairs"].get<std::vector<std::string>>();
+    EXPECT_TRUE(has(pairs, "f-ay"));
+    EXPECT_NEAR(p["duration"].get<double>(), rec.seconds, 1e-3);
+    EXPECT_TRUE(p["audio"].get<std::string>().starts_with("data:audio/wav;base64,UklGR"));
+    const auto frames = p["weights"]["times"].size();
+    EXPECT_NEAR(static_cast<double>(frames), rec.seconds * 100, 10);
+    for (const auto& row : p["weights"]["values"]) EXPECT_EQ(row.size(), frames);
+    EXPECT_GT(mostOpen(p), 0.2) << "the mouth opens for the vowels";
+}
+
+TEST(EditorApi, ARecordingWithoutWordsIsAnalysedFromTheAudioAndSaysSo) {
+    const auto dir = scratchDir("editor_recording_plain");
+    Editor e(dir / "crab.json");
+    const auto rec = recordingOf("Fine fast father");
+    const auto r = e.call("POST", "/api/preview", json{{"wav", uploadOf(rec.wav)}}.dump());
+    ASSERT_EQ(r.status, 200) << r.body.substr(0, 400);
+    const auto p = body(r);
+    EXPECT_EQ(p["source"], "audio-only");
+    EXPECT_FALSE(p.contains("words"));
+    ASSERT_EQ(p["warnings"].size(), 1u);
+    EXPECT_NE(p["warnings"][0].get<std::string>().find("no words given"), std::string::npos);
+    EXPECT_GE(p["schedule"].size(), 5u);
+    // Words the voice cannot read: the aligner is not used, and the reply says why.
+    const auto odd = body(
+        e.call("POST", "/api/preview", json{{"wav", uploadOf(rec.wav)}, {"text", "  "}}.dump()));
+    EXPECT_EQ(odd["source"], "audio-only");
+}
+
+TEST(EditorApi, ABadRecordingIsAClear400AndNoPathIsEverOpened) {
+    const auto dir = scratchDir("editor_recording_bad");
+    Editor e(dir / "crab.json");
+    const auto rec = recordingOf("Fine fast father");
+    struct Case {
+        json wav;
+        std::string message;
+    };
+    const std::vector<Case> cases{
+        {uploadOf(rec.wav.substr(0, rec.wav.size() / 2)), "wav: truncated: its RIFF header"},
+        {uploadOf(rec.wav.substr(0, 30)), "wav: truncated"},
+        {uploadOf("not audio at all, just some words"), "cannot decode audio"},
+        {"/etc/passwd", "cannot decode audio"},  // base64 digits, 8 bytes of nonsense
+        {"data:audio/wav;base64,%%%%", "wav: not base64"},
+        {"data:audio/wav,RIFF", "wav: not base64"},
+        {"", "wav: empty"},
+        {42, "not a path"},
+    };
+    for (const auto& c : cases) {
+        const auto r = e.call("POST", "/api/preview", json{{"wav", c.wav}}.dump());
+        EXPECT_EQ(r.status, 400) << c.wav.dump().substr(0, 80) << " -> " << r.body;
+        EXPECT_NE(errorOf(r).find(c.message), std::string::npos) << r.body;
+        EXPECT_EQ(errorOf(r).find("/proc/"), std::string::npos) << r.body;
+    }
+    EXPECT_EQ(
+        e.call("POST", "/api/preview", json{{"wav", uploadOf(rec.wav)}, {"text", 3}}.dump()).status,
+        400);
+}
+
+TEST(EditorApi, ARecordingOverTheLimitsIs413) {
+    const auto dir = scratchDir("editor_recording_big");
+    const auto rec = recordingOf("Fine fast father");
+    PreviewSettings small;
+    small.maxUploadBytes = rec.wav.size() / 2;
+    Editor bytes(dir / "crab.json", small);
+    const auto r = bytes.call("POST", "/api/preview", json{{"wav", uploadOf(rec.wav)}}.dump());
+    EXPECT_EQ(r.status, 413);
+    EXPECT_NE(errorOf(r).find("wav: more than"), std::string::npos) << r.body;
+    PreviewSettings brief;
+    brief.maxRecordingSeconds = rec.seconds / 2;
+    Editor seconds(dir / "crab.json", brief);
+    const auto s = seconds.call("POST", "/api/preview", json{{"wav", uploadOf(rec.wav)}}.dump());
+    EXPECT_EQ(s.status, 413);
+    EXPECT_NE(errorOf(s).find("the editor previews at most"), std::string::npos) << s.body;
+}
+
+TEST(EditorApi, PerformingNeedsAPuppet) {
+    const auto dir = scratchDir("editor_perform");
+    Editor e(dir / "crab.json");
+    const auto r = e.call("POST", "/api/perform", R"({"from": 0})");
+    EXPECT_EQ(r.status, 409);
+    EXPECT_NE(errorOf(r).find("--socket"), std::string::npos) << r.body;
+    EXPECT_TRUE(body(e.call("GET", "/api/bigrams"))["puppet"].is_null());
+}
+
+TEST(EditorApi, Base64RoundTripsAndRefusesWhatIsNot) {
+    for (const auto& bytes :
+         std::vector<std::string>{"", "a", "ab", "abc", "abcd", std::string("\0\xff\x10", 3)})
+        EXPECT_EQ(decodeBase64(encodeBase64(bytes)), bytes) << bytes;
+    EXPECT_FALSE(decodeBase64("a"));
+    EXPECT_FALSE(decodeBase64("ab c"));
+    EXPECT_FALSE(decodeBase64("data:text/plain,abcd"));
 }
 
 TEST(EditorApi, TokensAreRandomAndLong) {

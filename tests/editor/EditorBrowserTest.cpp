@@ -185,6 +185,30 @@ TEST(EditorBrowser, DragSavePreviewAndAnimateSeeTheChange) {
     EXPECT_GT(web.script("return document.querySelectorAll('#mouth path').length").get<int>(), 2);
     writeFile(shots / "editor-preview.png", web.screenshotPng());
 
+    // A recording with its words: picked in the page, sent as its bytes, aligned; it previews
+    // the same way (schedule, curves, audio, the pairs it uses).
+    const auto recording = dir / "what-fun.wav";
+    ASSERT_EQ(
+        runLipsync({"say", kSentence, "--voice", "en-us+f2", "--wav", recording.string()}).exitCode,
+        0);
+    web.script("document.body.dataset.preview = ''; app.used = new Set(); paintGrid();");
+    web.type("#recording", recording.string());
+    web.type("#words", kSentence);
+    web.click("#preview-recording");
+    ASSERT_TRUE(
+        waitFor([&] { return web.script("return document.body.dataset.preview") == "ready"; }, 30))
+        << web.script("return document.getElementById('error').textContent");
+    EXPECT_EQ(web.script("return document.body.dataset.source"), "aligned");
+    EXPECT_NE(web.script("return document.getElementById('status').textContent")
+                  .get<std::string>()
+                  .find("words aligned"),
+              std::string::npos);
+    EXPECT_TRUE(web.script("return document.querySelector(\"#grid button[data-pair='f-ah']\")"
+                           ".classList.contains('used')") == true);
+    EXPECT_TRUE(waitFor(
+        [&] { return web.script("return document.getElementById('audio').duration > 0") == true; },
+        10));
+
     // Save; the file holds its old bigram and the changed one, nothing else.
     web.click("#save");
     ASSERT_TRUE(waitFor(

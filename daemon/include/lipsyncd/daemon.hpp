@@ -74,7 +74,9 @@ struct DaemonConfig {
 // request, {"ok": true, ...} or {"ok": false, "error": "..."}.
 
 struct ControlArg {
-    enum class Type { String, Path, Boolean, Integer };  // Path: a string the client makes absolute
+    // Path: a string the client makes absolute; Weights: an object of names to finite numbers
+    // within [min, max], at most maxLength of them.
+    enum class Type { String, Path, Boolean, Integer, Weights };
     std::string_view name;
     Type type;
     bool required;

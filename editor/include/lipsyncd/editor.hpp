@@ -8,19 +8,26 @@
 //                   --character` loads them.
 //   MouthDrawing    how each pose moves the 2-D mouth the page draws (config/editor/mouth.toml).
 //   EditorApi       the HTTP API as a plain function of a request (token, routes, JSON, 4xx).
+//   PuppetStream    the puppet the service drives, moved by the preview: the weights go to
+//                   lipsyncd's control socket (`pose` requests) at their frame rate.
 //   EditorServer    cpp-httplib around the API and the page, which is built into the binary.
 #pragma once
 
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <filesystem>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/lipsync.hpp>
 #include <lipsyncd/tts.hpp>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <set>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 namespace lipsyncd::editor {
@@ -98,9 +105,52 @@ struct ApiResponse {
     std::string contentType = "application/json";
 };
 
+// The puppet that the running lipsyncd drives, moved by the preview: a thread sends the
+// weights of a preview to the control socket as `pose` requests, one per frame at the frames'
+// rate, from the moment the page starts playing the audio, each the puppet's lead early (as the
+// service drives a clip's mouth ahead of its sound). The service applies them through
+// the puppet's limits and slew and holds each briefly; when the stream stops, the mouth rests.
+class PuppetStream {
+  public:
+    // Asks the service its status: InputError naming the socket when nothing answers there,
+    // or when it drives another puppet than `puppet` (empty: any).
+    PuppetStream(std::filesystem::path socket, const std::string& puppet);
+    ~PuppetStream();
+    PuppetStream(const PuppetStream&) = delete;
+    PuppetStream& operator=(const PuppetStream&) = delete;
+
+    // Sends the frame at `fromSeconds` now and returns the service's refusal of it (a clip
+    // plays, a pose it does not know), if any; then streams the rest from a thread. Replaces
+    // what was streaming.
+    std::optional<std::string> play(PoseTrack track, double fromSeconds);
+    void stop();
+    const std::string& puppet() const { return puppet_; }
+    double leadSeconds() const { return leadSeconds_; }  // the puppet's, as the service says
+    std::size_t framesSent() const { return sent_; }     // by the last play()
+    std::string lastError() const;  // why the last stream stopped early ("" when it did not)
+
+  private:
+    void stream(PoseTrack track, std::size_t next, std::chrono::steady_clock::time_point start,
+                double from);
+    std::filesystem::path socket_;
+    std::string puppet_;
+    double leadSeconds_ = 0;
+    std::atomic<std::size_t> sent_ = 0;
+    mutable std::mutex mutex_;  // guards error_ and stopping_
+    std::condition_variable wake_;
+    std::string error_;
+    bool stopping_ = false;
+    std::thread thread_;
+};
+
 struct PreviewSettings {
     std::string voice = "en-us";
     lipsync::RuntimeConfig runtime;
+    std::filesystem::path templates;  // empty: the shipped default (recordings only)
+    // A recording's upload: at most this many bytes (after base64) and seconds.
+    std::size_t maxUploadBytes = 8u << 20;
+    double maxRecordingSeconds = 60;
+    PuppetStream* puppet = nullptr;  // --socket: the preview moves the puppet too
 };
 
 // The API of README "lipsync edit": every call needs the token; errors are 4xx with
@@ -119,6 +169,9 @@ class EditorApi {
     ApiResponse bigram(std::size_t first, std::size_t second) const;
     ApiResponse putBigram(std::size_t first, std::size_t second, const ApiRequest& request);
     ApiResponse preview(const ApiRequest& request);
+    ApiResponse previewRecording(const nlohmann::json& body, const std::string& voice,
+                                 const lipsync::RuntimeConfig& runtime);
+    ApiResponse perform(const ApiRequest& request);
     ApiResponse save();
 
     CharacterDraft draft_;
@@ -126,6 +179,8 @@ class EditorApi {
     std::string token_;
     EspeakSynthesizer* speech_;
     PreviewSettings settings_;
+    std::optional<dsp::TemplateSet> templates_;  // loaded by the first recording's preview
+    PoseTrack lastPreview_;                      // what /api/perform plays on the puppet
     std::mutex mutex_;
 };
 
