@@ -5,6 +5,7 @@
 // refused by name, and the daemon goes on.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <lipsyncd/daemon.hpp>
@@ -65,11 +66,18 @@ TEST(PoseRequest, AStreamOfPosesHoldsTheMouthWithoutResting) {
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
     const auto start = std::chrono::steady_clock::now();
+    auto last = start;
+    auto longestGap = std::chrono::steady_clock::duration{};
     while (std::chrono::steady_clock::now() - start < 1500ms) {  // 3× the stall timeout
         ASSERT_EQ(c.request({{"cmd", "pose"}, {"weights", {{"jaw", 0.4}}}})["ok"], true);
-        std::this_thread::sleep_for(100ms);
+        const auto now = std::chrono::steady_clock::now();
+        longestGap = std::max(longestGap, now - last);
+        last = now;
+        std::this_thread::sleep_for(30ms);
     }
     EXPECT_EQ(d.stop(), 0);
+    // A shared machine can stall this client longer than the 0.25 s hold; then resting is right.
+    if (longestGap > 200ms) GTEST_SKIP() << "the client stalled between two poses (machine busy)";
     const double t0 = firstMove(d);
     ASSERT_GT(t0, 0) << "the jaw never moved";
     // Up in 0.4 / 15 s; the last pose is held 0.25 s, the stall timeout starts after.
