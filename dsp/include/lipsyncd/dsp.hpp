@@ -572,6 +572,9 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
 struct ScriptWord {
     std::string text;
     PhonemeSchedule phonemes;
+    // Other ways the word is said (common reductions: "and" as /ən/ or /n/), aligned as
+    // parallel paths; the best-fitting one wins. Durations as in `phonemes`.
+    std::vector<PhonemeSchedule> alternatives = {};
 };
 
 struct AlignerConfig {
