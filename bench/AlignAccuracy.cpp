@@ -72,6 +72,7 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"silenceLoopCost", &dsp::AlignerConfig::silenceLoopCost},
         {"pauseCost", &dsp::AlignerConfig::pauseCost},
         {"skipWordCost", &dsp::AlignerConfig::skipWordCost},
+        {"reductionCost", &dsp::AlignerConfig::reductionCost},
         {"beam", &dsp::AlignerConfig::beam}};
     const std::map<std::string, double dsp::AlignerConfig::*> doubles = {
         {"minVowelSeconds", &dsp::AlignerConfig::minVowelSeconds},

@@ -32,6 +32,7 @@ struct EvalOptions {
     // instead of analysed from the audio alone; voices: "VOICE" for every speaker, or
     // "SPEAKER=VOICE" for one.
     bool align = false, reductions = true;
+    dsp::AlignerConfig aligner;
     std::vector<std::string> voices;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
@@ -126,7 +127,7 @@ struct Evaluator {
             return {std::move(a.schedule), std::move(a.levels)};
         }
         auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)), voiceFor(item.speaker), templates,
-                           o.frontEnd.config(), {}, o.frontEnd.decode(), std::nullopt,
+                           o.frontEnd.config(), o.aligner, o.frontEnd.decode(), std::nullopt,
                            o.reductions);
         for (const auto& w : r.warnings)
             std::cerr << "lipsync eval: " << item.speaker << '/' << item.name << ": " << w << '\n';
@@ -384,6 +385,14 @@ void addEvalCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voices,
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");
+    cmd->add_option("--min-word-confidence", o->aligner.minWordConfidence,
+                    "With --align: words placed with less confidence get audio-only analysis")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    cmd->add_option("--reduction-cost", o->aligner.reductionCost,
+                    "With --align: cost of saying a word another way than espeak-ng reads it")
+        ->check(CLI::Range(0.0, 100.0))
+        ->capture_default_str();
     cmd->add_flag("!--no-reductions", o->reductions,
                   "With --align: follow espeak-ng's reading only, without the common reductions "
                   "(config/reductions/LANG.toml)");

@@ -39,11 +39,11 @@ class GraphBuilder {
     void edge(int from, int to, float cost) { incoming_[to].push_back({from, cost}); }
 
     // Edges into `to` from the end of the unit before it, and, skipping words, from earlier.
-    void fromPreviousUnits(int to, std::size_t unit) {
+    void fromPreviousUnits(int to, std::size_t unit, float cost) {
         for (int skipped = 0; skipped <= kMaxSkippedInARow && skipped < static_cast<int>(unit);
              ++skipped)
             for (int from : units_[unit - 1 - skipped])
-                edge(from, to, config_.skipWordCost * static_cast<float>(skipped));
+                edge(from, to, cost + config_.skipWordCost * static_cast<float>(skipped));
     }
 
     // The pause and filler before word `gap` (after the last word when gap == words).
@@ -106,6 +106,7 @@ class GraphBuilder {
     }
 
     // One pronunciation's chain; returns its last node (-1: no sounds), `frames` its minimum.
+    // `expected`: espeak-ng's own reading; another (a reduction) costs reductionCost to enter.
     int addChain(const std::string& text, const PhonemeSchedule& phonemes, int w,
                  std::size_t unit, bool expected, int& frames) {
         int previous = -1;
@@ -138,7 +139,7 @@ class GraphBuilder {
                 if (previous >= 0)
                     edge(previous, n, 0);
                 else
-                    fromPreviousUnits(n, unit);
+                    fromPreviousUnits(n, unit, expected ? 0.0f : config_.reductionCost);
                 previous = n;
             }
             ++graph_.phones;
