@@ -83,7 +83,7 @@ TEST(AlignCli, TheLabellingScriptKeepsOnlyConfidentLabels) {
     // The labels are the aligned schedule: close to espeak-ng's own timings.
     const auto aligned = readScheduleFile(out / "anna" / "right.lab");
     const auto truth = readScheduleFile(in / "anna" / "right.lab");
-    EXPECT_GT(dsp::scoreSchedule(aligned, truth, PhonemeSet::common()).groupAccuracy(), 0.85);
+    EXPECT_GT(dsp::scoreSchedule(aligned, truth, PhonemeSet::common()).groupAccuracy(), 0.75);
     const auto usage = runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh"});
     EXPECT_EQ(usage.exitCode, 2);
 }
