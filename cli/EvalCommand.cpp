@@ -101,8 +101,7 @@ struct Evaluator {
         const auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
         const auto heard = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
         return {score(o.runtime.animate(schedule, runtime, &levels)),
-                score(o.runtime.animate(reference, runtime, &levels)),
-                score(envelopeTrack(heard))};
+                score(o.runtime.animate(reference, runtime, &levels)), score(envelopeTrack(heard))};
     }
 
     // The voice whose reading of the words a speaker's files are aligned with.
@@ -126,9 +125,9 @@ struct Evaluator {
                                       o.frontEnd.decode(), std::nullopt);
             return {std::move(a.schedule), std::move(a.levels)};
         }
-        auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)), voiceFor(item.speaker), templates,
-                           o.frontEnd.config(), o.aligner, o.frontEnd.decode(), std::nullopt,
-                           o.reductions);
+        auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
+                           voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner,
+                           o.frontEnd.decode(), std::nullopt, o.reductions);
         for (const auto& w : r.warnings)
             std::cerr << "lipsync eval: " << item.speaker << '/' << item.name << ": " << w << '\n';
         return {std::move(r.schedule), std::move(r.levels)};
@@ -274,10 +273,10 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
         const auto audio = worst(report, [](const Score& s) { return s.jaw.audio.r(); });
         const auto labels = worst(report, [](const Score& s) { return s.jaw.labels.r(); });
         out << "jaw through '" << o.puppet << "': r " << fixed2(report.total.jaw.audio.r())
-            << (o.align ? " aligned" : " from audio") << " (worst speaker " << audio.first << ' ' << fixed2(audio.second) << "), "
-            << fixed2(report.total.jaw.labels.r()) << " from the labels (worst " << labels.first
-            << ' ' << fixed2(labels.second) << "), envelope follower "
-            << fixed2(report.total.jaw.envelope.r()) << '\n';
+            << (o.align ? " aligned" : " from audio") << " (worst speaker " << audio.first << ' '
+            << fixed2(audio.second) << "), " << fixed2(report.total.jaw.labels.r())
+            << " from the labels (worst " << labels.first << ' ' << fixed2(labels.second)
+            << "), envelope follower " << fixed2(report.total.jaw.envelope.r()) << '\n';
     }
 }
 
@@ -294,8 +293,8 @@ void checkFloors(const Report& report, const EvalOptions& o) {
         const auto closures =
             worst(report, [](const Score& s) { return s.jaw.labels.closureRate(); });
         if (audio.second < o.minJawR)
-            why << "jaw r " << (o.align ? "aligned " : "from audio ") << fixed2(audio.second) << " (" << audio.first
-                << ") is below the floor " << fixed2(o.minJawR) << ". ";
+            why << "jaw r " << (o.align ? "aligned " : "from audio ") << fixed2(audio.second)
+                << " (" << audio.first << ") is below the floor " << fixed2(o.minJawR) << ". ";
         if (exact.second < o.minExactJawR)
             why << "jaw r from the labels " << fixed2(exact.second) << " (" << exact.first
                 << ") is below the floor " << fixed2(o.minExactJawR) << ". ";

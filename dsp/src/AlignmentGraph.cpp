@@ -107,8 +107,8 @@ class GraphBuilder {
 
     // One pronunciation's chain; returns its last node (-1: no sounds), `frames` its minimum.
     // `expected`: espeak-ng's own reading; another (a reduction) costs reductionCost to enter.
-    int addChain(const std::string& text, const PhonemeSchedule& phonemes, int w,
-                 std::size_t unit, bool expected, int& frames) {
+    int addChain(const std::string& text, const PhonemeSchedule& phonemes, int w, std::size_t unit,
+                 bool expected, int& frames) {
         int previous = -1;
         for (const auto& seg : phonemes) {
             const auto idx = set_.find(seg.phoneme);
@@ -120,9 +120,9 @@ class GraphBuilder {
             if (expected) graph_.expectedSeconds += expectedFrames * hop_;
             const double classMin =
                 (set_[*idx].vowel ? config_.minVowelSeconds : config_.minConsonantSeconds) / hop_;
-            const int chain = std::max(
-                1, static_cast<int>(std::lround(
-                       std::max(classMin, config_.minFractionOfExpected * expectedFrames))));
+            const int chain =
+                std::max(1, static_cast<int>(std::lround(std::max(
+                                classMin, config_.minFractionOfExpected * expectedFrames))));
             frames += chain;
             const double stay = std::clamp(1.0 - 1.0 / std::max(1.0, expectedFrames - chain + 1),
                                            kMinStay, kMaxStay);

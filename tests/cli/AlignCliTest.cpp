@@ -21,9 +21,9 @@ namespace fs = std::filesystem;
 void speak(const fs::path& dir, const std::string& name, const std::string& text,
            const std::string& voice, const std::string& words) {
     fs::create_directories(dir);
-    const auto r = runLipsync({"say", text, "--voice", voice, "--wav",
-                               (dir / (name + ".wav")).string(), "--schedule",
-                               (dir / (name + ".lab")).string()});
+    const auto r =
+        runLipsync({"say", text, "--voice", voice, "--wav", (dir / (name + ".wav")).string(),
+                    "--schedule", (dir / (name + ".lab")).string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     if (!words.empty()) std::ofstream(dir / (name + ".txt")) << words << '\n';
 }
@@ -48,8 +48,8 @@ TEST(AlignCli, EvalAlignScoresTheAlignedWordsPerSpeakerAndVoice) {
         EXPECT_GT(s["jaw"]["audio"]["r"].get<double>(), 0.6) << speaker;
     }
     // Russian words read by the English voice are spelled, not said: far worse, or refused.
-    const auto wrong = runLipsync({"eval", "--corpus", (dir / "ivan").string(), "--align",
-                                   "--json", "-", "--no-per-file"});
+    const auto wrong = runLipsync(
+        {"eval", "--corpus", (dir / "ivan").string(), "--align", "--json", "-", "--no-per-file"});
     if (wrong.exitCode == 0) {
         const auto j = nlohmann::json::parse(wrong.out.substr(wrong.out.find("\n{") + 1));
         EXPECT_LT(j["group_accuracy"].get<double>(),
@@ -69,12 +69,13 @@ TEST(AlignCli, TheLabellingScriptKeepsOnlyConfidentLabels) {
     const auto in = scratchDir("cli_label_in"), out = scratchDir("cli_label_out");
     const std::string line = "Seven puppets sang a song about the moon.";
     speak(in / "anna", "right", line, "en-us+f3", line);
-    speak(in / "anna", "wrong", "Moon.", "en-us+f3", line + " And then another song about the sun.");
+    speak(in / "anna", "wrong", "Moon.", "en-us+f3",
+          line + " And then another song about the sun.");
     speak(in / "anna", "unscripted", line, "en-us+f3", "");
     ::setenv("LIPSYNC", LIPSYNCD_LIPSYNC_BIN, 1);
-    const auto r = runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh",
-                                            in.string(), out.string(),
-                                            "--min-word-confidence", "0.1"});
+    const auto r =
+        runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh", in.string(),
+                                 out.string(), "--min-word-confidence", "0.1"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("anna: 1 files labelled (1 skipped"), std::string::npos) << r.err;
     EXPECT_TRUE(fs::exists(out / "anna" / "right.wav"));
@@ -84,7 +85,8 @@ TEST(AlignCli, TheLabellingScriptKeepsOnlyConfidentLabels) {
     const auto aligned = readScheduleFile(out / "anna" / "right.lab");
     const auto truth = readScheduleFile(in / "anna" / "right.lab");
     EXPECT_GT(dsp::scoreSchedule(aligned, truth, PhonemeSet::common()).groupAccuracy(), 0.75);
-    const auto usage = runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh"});
+    const auto usage =
+        runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh"});
     EXPECT_EQ(usage.exitCode, 2);
 }
 

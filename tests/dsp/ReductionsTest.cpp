@@ -62,8 +62,8 @@ TEST(Reductions, BadFilesNameTheLineAndPhoneme) {
 TEST(Reductions, WeakFormsAndRulesGiveAlternatives) {
     const auto map = espeakMapForVoice("en-us");
     const auto reductions = Reductions::forVoice("en-us", map);
-    const auto script = scriptForText(synth(), "bread and butter, last night", "en-us", map,
-                                      nullptr, &reductions);
+    const auto script =
+        scriptForText(synth(), "bread and butter, last night", "en-us", map, nullptr, &reductions);
     ASSERT_EQ(script.size(), 5u);
     std::vector<std::string> forms;
     for (const auto& a : script[1].alternatives) forms.push_back(classes(a));
@@ -109,12 +109,13 @@ Reduced speakReduced(const std::string& text, const std::vector<std::pair<int, s
     Reduced out;
     out.rate = s.sampleRate;
     for (std::size_t i = 0; i < s.samples.size(); ++i)
-        if (!isGone(static_cast<double>(i) / s.sampleRate)) out.samples.push_back(s.samples[i] / 32768.0f);
+        if (!isGone(static_cast<double>(i) / s.sampleRate))
+            out.samples.push_back(s.samples[i] / 32768.0f);
     PhonemeSchedule raw;
     for (const auto& p : s.phonemes)
         if (!isGone(p.start) || p.end - p.start < 1e-9)
-            raw.push_back({p.start - removedBefore(p.start), p.end - removedBefore(p.end), p.phoneme,
-                           1.0f});
+            raw.push_back(
+                {p.start - removedBefore(p.start), p.end - removedBefore(p.end), p.phoneme, 1.0f});
     out.labels = mapSchedule(raw, espeakMapForVoice("en-us"), nullptr);
     return out;
 }
@@ -135,21 +136,15 @@ double meanBoundaryError(const PhonemeSchedule& hyp, const PhonemeSchedule& ref)
 TEST(Reductions, AReducedUtteranceAlignsBetterWithThem) {
     const std::string text = "We ate bread and butter and jam last night, and then we went to bed.";
     // Every "and" said as a bare /n/, "las' night", "wen' to".
-    const auto s = speakReduced(text, {{3, "a"},
-                                       {3, "d"},
-                                       {5, "a"},
-                                       {5, "d"},
-                                       {7, "t"},
-                                       {9, "a"},
-                                       {9, "d"},
-                                       {12, "t"}});
-    const auto file = test::writeAudio("reduced.wav", s.samples, s.rate,
-                                       SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+    const auto s = speakReduced(
+        text, {{3, "a"}, {3, "d"}, {5, "a"}, {5, "d"}, {7, "t"}, {9, "a"}, {9, "d"}, {12, "t"}});
+    const auto file =
+        test::writeAudio("reduced.wav", s.samples, s.rate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
     const auto templates = dsp::TemplateSet::loadDefault();
-    const auto with = alignText(synth(), file, text, "en-us", templates, {}, {}, {}, std::nullopt,
-                                true);
-    const auto without = alignText(synth(), file, text, "en-us", templates, {}, {}, {},
-                                   std::nullopt, false);
+    const auto with =
+        alignText(synth(), file, text, "en-us", templates, {}, {}, {}, std::nullopt, true);
+    const auto without =
+        alignText(synth(), file, text, "en-us", templates, {}, {}, {}, std::nullopt, false);
     const double errWith = meanBoundaryError(with.alignment.schedule, s.labels);
     const double errWithout = meanBoundaryError(without.alignment.schedule, s.labels);
     EXPECT_LT(errWith, errWithout * 0.9) << "with " << errWith << " s, without " << errWithout;

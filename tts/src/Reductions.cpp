@@ -23,8 +23,7 @@ std::vector<std::string> splitPhonemes(const std::string& s) {
 std::string keyOf(const std::string& written) {
     std::string key;
     for (const unsigned char c : written)
-        if (std::isalpha(c) || c == '\'' || c >= 0x80)
-            key += static_cast<char>(std::tolower(c));
+        if (std::isalpha(c) || c == '\'' || c >= 0x80) key += static_cast<char>(std::tolower(c));
     return key;
 }
 
@@ -64,9 +63,9 @@ PhonemeSchedule withDurations(const std::vector<std::string>& phonemes,
     for (const auto& p : phonemes) {
         double d = 0.06;
         if (!reading.empty()) {
-            auto it = std::find_if(reading.begin() + static_cast<std::ptrdiff_t>(cursor),
-                                   reading.end(),
-                                   [&](const PhonemeSegment& s) { return s.phoneme == p; });
+            auto it =
+                std::find_if(reading.begin() + static_cast<std::ptrdiff_t>(cursor), reading.end(),
+                             [&](const PhonemeSegment& s) { return s.phoneme == p; });
             if (it != reading.end()) {
                 cursor = static_cast<std::size_t>(it - reading.begin()) + 1;
                 d = it->duration();
@@ -129,8 +128,7 @@ Reductions Reductions::forVoice(const std::string& voice, const PhonemeMap& map)
 }
 
 std::vector<PhonemeSchedule> Reductions::alternatives(const SpokenWord& word,
-                                                      const SpokenWord* next,
-                                                      const PhonemeMap& map,
+                                                      const SpokenWord* next, const PhonemeMap& map,
                                                       const PhonemeSet& set) const {
     const Classes classes{map, set};
     const auto reading = soundsOf(word.phonemes, map);

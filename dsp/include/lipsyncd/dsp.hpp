@@ -609,7 +609,7 @@ struct AlignerConfig {
     // Saying a word another way than espeak-ng reads it (ScriptWord::alternatives): a reduction
     // must fit clearly better to be taken. See bench/align_accuracy and README for the tuning.
     float reductionCost = 4.0f;
-    float beam = 60.0f;             // paths this much worse than the best are dropped
+    float beam = 60.0f;  // paths this much worse than the best are dropped
     int maxActiveNodes = 4000;
     // Bounded memory: every commitSeconds, the path up to lookaheadSeconds ago is final.
     double commitSeconds = 10, lookaheadSeconds = 4;
