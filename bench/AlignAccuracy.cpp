@@ -2,7 +2,7 @@
 // aligned with its sentence and its phoneme boundaries compared with NAME.lab (espeak-ng's own
 // timings). The voice's language (not its variant, rate or pitch) is what the aligner is told.
 //
-//   build/bench/align_accuracy CORPUS_DIR SENTENCES_FILE [name=value ...]
+//   build/bench/align_accuracy CORPUS_DIR SENTENCES_FILE [name=value ...] [templates=FILE]
 //   build/bench/align_accuracy build/corpus/dev config/corpus/dev-sentences.txt
 //
 // name=value sets an AlignerConfig field (see kFields) for tuning, which is done on the
@@ -72,6 +72,7 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"silenceLoopCost", &dsp::AlignerConfig::silenceLoopCost},
         {"pauseCost", &dsp::AlignerConfig::pauseCost},
         {"skipWordCost", &dsp::AlignerConfig::skipWordCost},
+        {"reductionCost", &dsp::AlignerConfig::reductionCost},
         {"beam", &dsp::AlignerConfig::beam}};
     const std::map<std::string, double dsp::AlignerConfig::*> doubles = {
         {"minVowelSeconds", &dsp::AlignerConfig::minVowelSeconds},
@@ -101,7 +102,14 @@ int main(int argc, char** argv) {
         return 2;
     }
     dsp::AlignerConfig config;
-    for (int i = 3; i < argc; ++i) set(config, argv[i]);
+    std::string templatesFile;  // templates=FILE: another template set (a second pass)
+    for (int i = 3; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg.rfind("templates=", 0) == 0)
+            templatesFile = arg.substr(10);
+        else
+            set(config, arg);
+    }
     std::vector<std::string> sentences;
     std::ifstream in(argv[2]);
     for (std::string line; std::getline(in, line);)
@@ -113,7 +121,8 @@ int main(int argc, char** argv) {
     std::sort(files.begin(), files.end());
 
     EspeakSynthesizer synth;
-    const auto templates = dsp::TemplateSet::loadDefault();
+    const auto templates = templatesFile.empty() ? dsp::TemplateSet::loadDefault()
+                                                 : dsp::TemplateSet::load(templatesFile);
     std::vector<double> errors;
     std::size_t words = 0, placed = 0;
     double audioSeconds = 0, cpuSeconds = 0;

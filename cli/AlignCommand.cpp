@@ -1,6 +1,5 @@
 // lipsync align: audio plus the words spoken in it → the schedule, by forced alignment of
 // espeak-ng's reading of the words on the front end's per-frame distances.
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <lipsyncd/core.hpp>
@@ -10,6 +9,7 @@
 #include <sstream>
 
 #include "Commands.hpp"
+#include "Corpus.hpp"
 #include "FrontEndOptions.hpp"
 #include "Output.hpp"
 #include "RuntimeOptions.hpp"
@@ -28,16 +28,8 @@ struct AlignOptions {
     float minWordConfidence = dsp::AlignerConfig{}.minWordConfidence;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
-    bool quiet = false;
+    bool quiet = false, reductions = true;
 };
-
-std::string readTextFile(const std::string& file) {
-    std::ifstream in(file);
-    if (!in) throw InputError(file + ": cannot open the text file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
 
 void writeWords(std::ostream& out, const std::vector<dsp::AlignedWord>& words) {
     out << "# start\tend\tword\tconfidence\tplaced\texcess_db\tduration_ratio\n"
@@ -73,7 +65,7 @@ void runAlign(const AlignOptions& o) {
     aligner.minWordConfidence = o.minWordConfidence;
     EspeakSynthesizer synth;
     const auto r = alignText(synth, o.input, text, o.voice, templates, o.frontEnd.config(), aligner,
-                             o.frontEnd.decode(), o.frontEnd.raw());
+                             o.frontEnd.decode(), o.frontEnd.raw(), o.reductions);
     for (const auto& w : r.warnings) std::cerr << "lipsync align: warning: " << w << '\n';
     if (!o.quiet) {
         const auto placed = std::count_if(r.alignment.words.begin(), r.alignment.words.end(),
@@ -120,6 +112,9 @@ void addAlignCommand(CLI::App& app) {
                     "Words placed with less confidence get audio-only analysis instead")
         ->check(CLI::Range(0.0, 1.0))
         ->capture_default_str();
+    cmd->add_flag("!--no-reductions", o->reductions,
+                  "Follow espeak-ng's reading only, without the common reductions "
+                  "(config/reductions/LANG.toml: weak forms, t/d and schwa deletion)");
     cmd->add_flag("--quiet,-q", o->quiet, "No summary on stderr");
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, true);

@@ -1,7 +1,9 @@
 #include "Corpus.hpp"
 
 #include <algorithm>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <tuple>
 
 namespace lipsyncd::cli {
@@ -38,6 +40,14 @@ std::vector<CorpusItem> listCorpus(const fs::path& dir, std::vector<std::string>
     });
     if (items.empty()) throw InputError(dir.string() + ": no NAME.wav + NAME.lab pairs");
     return items;
+}
+
+std::string readTextFile(const fs::path& file) {
+    std::ifstream in(file);
+    if (!in) throw InputError(file.string() + ": cannot open the text file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
 }
 
 PhonemeSchedule readLabels(const fs::path& file, const std::string& alphabet,

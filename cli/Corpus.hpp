@@ -23,6 +23,10 @@ struct CorpusItem {
 std::vector<CorpusItem> listCorpus(const std::filesystem::path& dir,
                                    std::vector<std::string>* skipped = nullptr);
 
+// The whole of a text file (the words of a recording: `lipsync align --text-file`, NAME.txt
+// beside NAME.wav for `lipsync eval --align`). Throws InputError naming a file it cannot open.
+std::string readTextFile(const std::filesystem::path& file);
+
 // Reads labels in `alphabet`: "common", "arpabet", a map name or file, or "auto" (common-set
 // names if every symbol is one, else ARPAbet).
 // `set`: the classes the schedule is in (default: the common set).

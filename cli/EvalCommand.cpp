@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <iostream>
 #include <lipsyncd/dsp.hpp>
+#include <lipsyncd/tts.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -27,13 +28,19 @@ struct EvalOptions {
     double minAccuracy = 0, minGroupAccuracy = 0;
     double minJawR = -1, minExactJawR = -1, minExactClosures = 0;
     bool perFile = true, jaw = true;
+    // --align: each NAME.wav is aligned on the words of NAME.txt beside it (lipsync align)
+    // instead of analysed from the audio alone; voices: "VOICE" for every speaker, or
+    // "SPEAKER=VOICE" for one.
+    bool align = false, reductions = true;
+    dsp::AlignerConfig aligner;
+    std::vector<std::string> voices;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
 };
 
 // The three ways a jaw can be driven, each scored against the same reference.
 struct JawScores {
-    lipsync::JawScore audio;     // audio → analyze → runtime → puppet
+    lipsync::JawScore audio;     // audio → analyze (or align) → runtime → puppet
     lipsync::JawScore labels;    // reference phonemes → runtime → puppet
     lipsync::JawScore envelope;  // audio → loudness envelope follower → puppet
     void add(const JawScores& o) {
@@ -59,9 +66,11 @@ struct Evaluator {
     dsp::TemplateSet templates = o.frontEnd.loadTemplates();
     RuntimeOptions::Loaded runtime = o.runtime.load();
     std::optional<PuppetJaw> puppet;
+    std::unique_ptr<EspeakSynthesizer> synth;  // --align: reads the words
 
     explicit Evaluator(const EvalOptions& options) : o(options) {
         if (o.jaw) puppet.emplace(output::Puppet::named(o.puppet), o.jawActuator);
+        if (o.align) synth = std::make_unique<EspeakSynthesizer>();
     }
 
     // The pose track an envelope follower makes: its value on the jaw pose, nothing else.
@@ -80,7 +89,7 @@ struct Evaluator {
     }
 
     JawScores scoreJaws(const CorpusItem& item, const PhonemeSchedule& reference,
-                        const dsp::AnalysisResult& analysis) const {
+                        const PhonemeSchedule& schedule, const LevelTrack& levels) const {
         const auto frames = static_cast<std::size_t>(reference.back().end * kFrameRate) + 1;
         const auto truth = lipsync::jawReference(reference, set, kFrameRate, frames);
         const auto score = [&](const PoseTrack& track) {
@@ -91,18 +100,45 @@ struct Evaluator {
         // does; the envelope follower, like a jaw board, hears the audio itself.
         const auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
         const auto heard = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
-        return {score(o.runtime.animate(analysis.schedule, runtime, &analysis.levels)),
-                score(o.runtime.animate(reference, runtime, &analysis.levels)),
-                score(envelopeTrack(heard))};
+        return {score(o.runtime.animate(schedule, runtime, &levels)),
+                score(o.runtime.animate(reference, runtime, &levels)), score(envelopeTrack(heard))};
+    }
+
+    // The voice whose reading of the words a speaker's files are aligned with.
+    std::string voiceFor(const std::string& speaker) const {
+        std::string voice = "en-us";
+        for (const auto& v : o.voices) {
+            const auto eq = v.find('=');
+            if (eq == std::string::npos)
+                voice = v;
+            else if (v.substr(0, eq) == speaker)
+                return v.substr(eq + 1);
+        }
+        return voice;
+    }
+
+    // The schedule under test and the levels the runtime opens the jaw by: aligned on the
+    // words beside the file (--align), else analysed from the audio alone.
+    std::pair<PhonemeSchedule, LevelTrack> schedule(const CorpusItem& item) const {
+        if (!o.align) {
+            auto a = dsp::analyzeFile(item.audio, templates, set, o.frontEnd.config(),
+                                      o.frontEnd.decode(), std::nullopt);
+            return {std::move(a.schedule), std::move(a.levels)};
+        }
+        auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
+                           voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner,
+                           o.frontEnd.decode(), std::nullopt, o.reductions);
+        for (const auto& w : r.warnings)
+            std::cerr << "lipsync eval: " << item.speaker << '/' << item.name << ": " << w << '\n';
+        return {std::move(r.schedule), std::move(r.levels)};
     }
 
     Score scoreFile(const CorpusItem& item) const {
         const auto reference = readLabels(item.labels, o.labels);
-        const auto analysis = dsp::analyzeFile(item.audio, templates, set, o.frontEnd.config(),
-                                               o.frontEnd.decode(), std::nullopt);
+        const auto [hypothesis, levels] = schedule(item);
         Score s;
-        s.schedule = dsp::scoreSchedule(analysis.schedule, reference, set);
-        if (puppet && !reference.empty()) s.jaw = scoreJaws(item, reference, analysis);
+        s.schedule = dsp::scoreSchedule(hypothesis, reference, set);
+        if (puppet && !reference.empty()) s.jaw = scoreJaws(item, reference, hypothesis, levels);
         return s;
     }
 };
@@ -231,15 +267,16 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
         << ", frames " << report.total.schedule.frames << ": accuracy "
         << pct(report.total.schedule.accuracy()) << " (common set), "
         << pct(report.total.schedule.groupAccuracy()) << " (visual groups); worst speaker "
-        << group.first << ' ' << pct(group.second) << '\n';
+        << group.first << ' ' << pct(group.second) << (o.align ? " (aligned on the words)" : "")
+        << '\n';
     if (o.jaw) {
         const auto audio = worst(report, [](const Score& s) { return s.jaw.audio.r(); });
         const auto labels = worst(report, [](const Score& s) { return s.jaw.labels.r(); });
         out << "jaw through '" << o.puppet << "': r " << fixed2(report.total.jaw.audio.r())
-            << " from audio (worst speaker " << audio.first << ' ' << fixed2(audio.second) << "), "
-            << fixed2(report.total.jaw.labels.r()) << " from the labels (worst " << labels.first
-            << ' ' << fixed2(labels.second) << "), envelope follower "
-            << fixed2(report.total.jaw.envelope.r()) << '\n';
+            << (o.align ? " aligned" : " from audio") << " (worst speaker " << audio.first << ' '
+            << fixed2(audio.second) << "), " << fixed2(report.total.jaw.labels.r())
+            << " from the labels (worst " << labels.first << ' ' << fixed2(labels.second)
+            << "), envelope follower " << fixed2(report.total.jaw.envelope.r()) << '\n';
     }
 }
 
@@ -256,8 +293,8 @@ void checkFloors(const Report& report, const EvalOptions& o) {
         const auto closures =
             worst(report, [](const Score& s) { return s.jaw.labels.closureRate(); });
         if (audio.second < o.minJawR)
-            why << "jaw r from audio " << fixed2(audio.second) << " (" << audio.first
-                << ") is below the floor " << fixed2(o.minJawR) << ". ";
+            why << "jaw r " << (o.align ? "aligned " : "from audio ") << fixed2(audio.second)
+                << " (" << audio.first << ") is below the floor " << fixed2(o.minJawR) << ". ";
         if (exact.second < o.minExactJawR)
             why << "jaw r from the labels " << fixed2(exact.second) << " (" << exact.first
                 << ") is below the floor " << fixed2(o.minExactJawR) << ". ";
@@ -271,7 +308,14 @@ void checkFloors(const Report& report, const EvalOptions& o) {
 void runEval(const EvalOptions& o) {
     const Evaluator evaluator(o);
     std::vector<std::string> skipped;
-    const auto items = listCorpus(o.corpus, &skipped);
+    auto items = listCorpus(o.corpus, &skipped);
+    if (o.align)
+        std::erase_if(items, [&](const CorpusItem& item) {
+            if (wordsBeside(item.audio)) return false;
+            skipped.push_back(item.audio.string() + ": no words file " + item.name + ".txt");
+            return true;
+        });
+    if (items.empty()) throw InputError(o.corpus + ": no NAME.wav with NAME.txt beside it");
     for (const auto& s : skipped) std::cerr << "lipsync eval: skipped " << s << '\n';
     Report report;
     for (std::size_t i = 0; i < items.size(); ++i) {
@@ -333,6 +377,24 @@ void addEvalCommand(CLI::App& app) {
                     "below this")
         ->check(CLI::Range(0.0, 1.0));
     cmd->add_flag("!--no-per-file", o->perFile, "Leave out the per-file table");
+    cmd->add_flag("--align", o->align,
+                  "Score 'lipsync align' instead: each NAME.wav aligned on the words of NAME.txt "
+                  "beside it (files without one are skipped); the jaw 'audio' column is then "
+                  "the aligned schedule's");
+    cmd->add_option("--voice", o->voices,
+                    "With --align: the espeak-ng voice reading the words, VOICE for every "
+                    "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");
+    cmd->add_option("--min-word-confidence", o->aligner.minWordConfidence,
+                    "With --align: words placed with less confidence get audio-only analysis")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    cmd->add_option("--reduction-cost", o->aligner.reductionCost,
+                    "With --align: cost of saying a word another way than espeak-ng reads it")
+        ->check(CLI::Range(0.0, 100.0))
+        ->capture_default_str();
+    cmd->add_flag("!--no-reductions", o->reductions,
+                  "With --align: follow espeak-ng's reading only, without the common reductions "
+                  "(config/reductions/LANG.toml)");
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, false);
     cmd->callback([o] { runEval(*o); });

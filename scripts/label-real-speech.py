@@ -5,7 +5,8 @@
 
 ROOT is where the Debian packages were unpacked (dpkg -x). The speakers, their split and their
 source are read from config/corpus/real-speakers.txt. Every item becomes
-OUT_DIR/SPLIT/SPEAKER/NAME.wav (16 kHz mono 16-bit, by sox) and NAME.lab (common-set labels).
+OUT_DIR/SPLIT/SPEAKER/NAME.wav (16 kHz mono 16-bit, by sox), NAME.lab (common-set labels) and
+NAME.txt (the words spoken, for `lipsync align` and `lipsync eval --align`).
 
 Labels:
 - words known (English): forced alignment with pocketsphinx and its en-us model, a development
@@ -59,7 +60,8 @@ def load_speakers(path):
     return speakers
 
 
-# --- sources: each yields (name, audio path, words or None, ready labels or None) -------------
+# --- sources: each yields (name, audio path, words or None, ready labels or None, text) -------
+# text: the words spoken as a script would give them (NAME.txt).
 
 def words_of(text):
     text = re.sub(r"\[[^\]]*\]", " ", text.lower())
@@ -78,14 +80,14 @@ def asterisk_items(root, voice, lang):
             audio = base / f"{key}.wav"
             if audio.exists() and "[" not in text:
                 words = words_of(text) if lang == "en" else ("espeak", lang, text.strip())
-                yield key.replace("/", "_"), audio, words, None
+                yield key.replace("/", "_"), audio, words, None, text.strip()
 
 
 def klettres_items(root, lang):
     base = root / "usr/share/klettres" / lang
     for sub in ("alpha", "syllab"):
         for audio in sorted((base / sub).glob("*.ogg")):
-            yield f"{sub}_{audio.stem}", audio, [audio.stem.lower()], None
+            yield f"{sub}_{audio.stem}", audio, [audio.stem.lower()], None, audio.stem.lower()
 
 
 def ktuberling_items(root, lang):
@@ -97,12 +99,17 @@ def ktuberling_items(root, lang):
             words[key.strip()] = text.split()
     for audio in sorted((root / "usr/share/ktuberling/sounds" / lang).glob("*.ogg")):
         if audio.stem in words:
-            yield audio.stem, audio, words[audio.stem], None
+            yield audio.stem, audio, words[audio.stem], None, " ".join(words[audio.stem])
 
 
 def festvox_ru_items(root):
     base = root / "usr/share/festival/voices/russian/msu_ru_nsh_clunits"
     phones = load_map("festvox-ru")
+    texts = {}  # etc/txt.done.data: ( ru_0001 "text" ), '+' before a stressed vowel
+    for line in (base / "etc/txt.done.data").read_text(encoding="utf-8").splitlines():
+        m = re.match(r'\(\s*(\S+)\s+"(.*)"\s*\)', line)
+        if m:
+            texts[m.group(1)] = m.group(2).replace("+", "")
     for lab in sorted((base / "lab").glob("*.lab")):
         segments, start = [], 0.0
         for line in lab.read_text().splitlines():
@@ -114,7 +121,7 @@ def festvox_ru_items(root):
                 sys.exit(f"{lab}: phone '{fields[2]}' is not in config/phonemes/festvox-ru.toml")
             segments.append((start, end, phones[fields[2]]))
             start = end
-        yield lab.stem, base / "wav" / f"{lab.stem}.wav", None, segments
+        yield lab.stem, base / "wav" / f"{lab.stem}.wav", None, segments, texts.get(lab.stem)
 
 
 def items_of(root, source):
@@ -223,6 +230,11 @@ def write_lab(path, segments, duration):
             f.write(f"{last:.3f}\t{duration:.3f}\tsil\n")
 
 
+def write_text(path, text):
+    if text and (not path.exists() or path.read_text(encoding="utf-8") != text + "\n"):
+        path.write_text(text + "\n", encoding="utf-8")
+
+
 def convert(src, dst):
     subprocess.run(["sox", "-q", str(src), "-r", "16000", "-c", "1", "-b", "16", str(dst)],
                    check=True)
@@ -251,11 +263,12 @@ def main():
             folder = args.out / split / speaker
             folder.mkdir(parents=True, exist_ok=True)
             made = skipped = 0
-            for name, audio, words, segments in items_of(args.root, source):
+            for name, audio, words, segments, text in items_of(args.root, source):
                 if args.subset and made >= args.subset:
                     break
                 wav, lab = folder / f"{name}.wav", folder / f"{name}.lab"
                 if lab.exists() and wav.exists():
+                    write_text(folder / f"{name}.txt", text)
                     made += 1
                     continue
                 if words is not None:
@@ -273,6 +286,7 @@ def main():
                         skipped += 1
                         continue
                 write_lab(lab, segments, duration)
+                write_text(folder / f"{name}.txt", text)
                 made += 1
             log(f"{split}/{speaker}: {made} files ({skipped} skipped: words unknown or not aligned)")
 

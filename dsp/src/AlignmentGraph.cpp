@@ -39,11 +39,11 @@ class GraphBuilder {
     void edge(int from, int to, float cost) { incoming_[to].push_back({from, cost}); }
 
     // Edges into `to` from the end of the unit before it, and, skipping words, from earlier.
-    void fromPreviousUnits(int to, std::size_t unit) {
+    void fromPreviousUnits(int to, std::size_t unit, float cost) {
         for (int skipped = 0; skipped <= kMaxSkippedInARow && skipped < static_cast<int>(unit);
              ++skipped)
             for (int from : units_[unit - 1 - skipped])
-                edge(from, to, config_.skipWordCost * static_cast<float>(skipped));
+                edge(from, to, cost + config_.skipWordCost * static_cast<float>(skipped));
     }
 
     // The pause and filler before word `gap` (after the last word when gap == words).
@@ -82,25 +82,50 @@ class GraphBuilder {
         units_.back().push_back(f);
     }
 
+    // A word: a chain per pronunciation, side by side (each entered from the unit before and
+    // left into the unit after); the first pronunciation sets the expected duration.
     void addWord(const ScriptWord& word, int w) {
-        int previous = -1;
         const double before = graph_.expectedSeconds;
-        for (const auto& seg : word.phonemes) {
+        const std::size_t unit = units_.size();
+        std::vector<int> lasts;
+        int shortest = std::numeric_limits<int>::max();
+        for (std::size_t k = 0; k <= word.alternatives.size(); ++k) {
+            const auto& phonemes = k == 0 ? word.phonemes : word.alternatives[k - 1];
+            int frames = 0;
+            const int last = addChain(word.text, phonemes, w, unit, k == 0, frames);
+            if (last < 0) {
+                if (k == 0) throw InputError("word '" + word.text + "' has no phonemes to align");
+                continue;  // an alternative of silence only: nothing to add
+            }
+            lasts.push_back(last);
+            shortest = std::min(shortest, frames);
+        }
+        graph_.minimumFrames += shortest;
+        units_.push_back(lasts);
+        graph_.wordExpectedSeconds.push_back(graph_.expectedSeconds - before);
+    }
+
+    // One pronunciation's chain; returns its last node (-1: no sounds), `frames` its minimum.
+    // `expected`: espeak-ng's own reading; another (a reduction) costs reductionCost to enter.
+    int addChain(const std::string& text, const PhonemeSchedule& phonemes, int w, std::size_t unit,
+                 bool expected, int& frames) {
+        int previous = -1;
+        for (const auto& seg : phonemes) {
             const auto idx = set_.find(seg.phoneme);
             if (!idx)
-                throw InputError("word '" + word.text + "': phoneme '" + seg.phoneme +
+                throw InputError("word '" + text + "': phoneme '" + seg.phoneme +
                                  "' is not in the phoneme set");
             if (*idx == set_.silence()) continue;  // pauses are the gaps' job
-            const double expected = std::max(hop_, seg.duration() * scale_) / hop_;
-            graph_.expectedSeconds += expected * hop_;
+            const double expectedFrames = std::max(hop_, seg.duration() * scale_) / hop_;
+            if (expected) graph_.expectedSeconds += expectedFrames * hop_;
             const double classMin =
                 (set_[*idx].vowel ? config_.minVowelSeconds : config_.minConsonantSeconds) / hop_;
-            const int chain = std::max(
-                1, static_cast<int>(
-                       std::lround(std::max(classMin, config_.minFractionOfExpected * expected))));
-            graph_.minimumFrames += chain;
-            const double stay =
-                std::clamp(1.0 - 1.0 / std::max(1.0, expected - chain + 1), kMinStay, kMaxStay);
+            const int chain =
+                std::max(1, static_cast<int>(std::lround(std::max(
+                                classMin, config_.minFractionOfExpected * expectedFrames))));
+            frames += chain;
+            const double stay = std::clamp(1.0 - 1.0 / std::max(1.0, expectedFrames - chain + 1),
+                                           kMinStay, kMaxStay);
             for (int k = 0; k < chain; ++k) {
                 AlignmentNode node;
                 node.phoneme = static_cast<int>(*idx);
@@ -114,14 +139,12 @@ class GraphBuilder {
                 if (previous >= 0)
                     edge(previous, n, 0);
                 else
-                    fromPreviousUnits(n, units_.size());
+                    fromPreviousUnits(n, unit, expected ? 0.0f : config_.reductionCost);
                 previous = n;
             }
             ++graph_.phones;
         }
-        if (previous < 0) throw InputError("word '" + word.text + "' has no phonemes to align");
-        units_.push_back({previous});
-        graph_.wordExpectedSeconds.push_back(graph_.expectedSeconds - before);
+        return previous;
     }
 
     void flatten() {

@@ -1,7 +1,8 @@
 // The state graph of a forced alignment: a start node; then, for every gap between words (and
 // before the first and after the last), an optional pause and an optional filler; and for every
 // phoneme of every word a chain of minimum-duration nodes, the last with a self-loop whose
-// probability gives the expected duration (a geometric tail; Rabiner 1989, section IV.D).
+// probability gives the expected duration (a geometric tail; Rabiner 1989, section IV.D). A word
+// said more than one way (reductions) has one such run of chains per pronunciation, in parallel.
 // Nodes are in time order: every edge goes forward, so the Viterbi pass is one sweep.
 #pragma once
 

@@ -28,8 +28,11 @@ void AlignmentPath::add(double time, int node, std::span<const float> excessDb) 
     const bool same = run_.node >= 0 && current.kind == n.kind && current.word == n.word &&
                       current.phone == n.phone;
     if (!same) {
+        // A run starts where the one before ended, to the bit: written with rounding, the two
+        // times computed apart could overlap by a millisecond and not read back.
+        const double from = run_.node >= 0 ? run_.end : start;
         closeRun();
-        run_ = {node, start, end};
+        run_ = {node, from, end};
     }
     run_.end = end;
     if (n.kind == AlignmentNode::Kind::Phoneme) {

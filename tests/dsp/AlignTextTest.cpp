@@ -9,6 +9,7 @@
 #include <lipsyncd/tts.hpp>
 
 #include "TestSpeech.hpp"
+#include "TestSynth.hpp"
 
 namespace lipsyncd {
 namespace {
@@ -22,10 +23,8 @@ struct Spoken {
     PhonemeSchedule labels;
 };
 
-// espeak-ng cannot be initialised again once terminated: one synthesiser for the process.
 EspeakSynthesizer& synth() {
-    static EspeakSynthesizer instance;
-    return instance;
+    return test::espeak();
 }
 
 Spoken speak(const std::string& text, const std::string& voice = "en-us+f3", int wpm = 150) {

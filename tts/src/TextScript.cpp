@@ -55,10 +55,10 @@ void warn(std::vector<std::string>* warnings, std::string message) {
     if (warnings) warnings->push_back(std::move(message));
 }
 
-dsp::ScriptWord mapWord(const SpokenWord& spoken, const PhonemeMap& map,
-                        std::vector<std::string>* warnings) {
-    dsp::ScriptWord word{spoken.text, {}};
-    for (const auto& p : spoken.phonemes) {
+PhonemeSchedule mapPhonemes(const SpokenWord& spoken, const PhonemeSchedule& phonemes,
+                            const PhonemeMap& map, std::vector<std::string>* warnings) {
+    PhonemeSchedule out;
+    for (const auto& p : phonemes) {
         if (map.isIgnored(p.phoneme)) continue;
         const auto r = map.map(p.phoneme);
         if (!r) {
@@ -66,9 +66,9 @@ dsp::ScriptWord mapWord(const SpokenWord& spoken, const PhonemeMap& map,
                                "' (not in map " + map.name() + "); left out");
             continue;
         }
-        word.phonemes.push_back({p.start, p.end, r->phoneme, 1.0f});
+        out.push_back({p.start, p.end, r->phoneme, 1.0f});
     }
-    return word;
+    return out;
 }
 
 bool hasSound(const dsp::ScriptWord& w) {
@@ -79,21 +79,30 @@ bool hasSound(const dsp::ScriptWord& w) {
 
 std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::string& text,
                                            const std::string& voice, const PhonemeMap& map,
-                                           std::vector<std::string>* warnings) {
+                                           std::vector<std::string>* warnings,
+                                           const Reductions* reductions) {
     if (std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isspace(c) != 0; }))
         throw InputError("the text to align is empty");
     const auto speech = synth.synthesize({text, voice, 0, -1});
     const auto language = languageOf(voice);
+    const auto& set = PhonemeSet::named(map.phonemeSet());
     std::vector<dsp::ScriptWord> script;
-    for (const auto& spoken : speech.words) {
+    for (std::size_t i = 0; i < speech.words.size(); ++i) {
+        const auto& spoken = speech.words[i];
         if (!readable(spoken.text, language)) {
             warn(warnings, "word '" + spoken.text + "' is in a script voice '" + voice +
                                "' cannot read (espeak-ng would spell it): left to audio-only "
                                "analysis");
             continue;
         }
-        auto word = mapWord(spoken, map, warnings);
-        if (hasSound(word)) script.push_back(std::move(word));
+        dsp::ScriptWord word{spoken.text, mapPhonemes(spoken, spoken.phonemes, map, warnings)};
+        if (!hasSound(word)) continue;
+        if (reductions) {
+            const auto* next = i + 1 < speech.words.size() ? &speech.words[i + 1] : nullptr;
+            for (const auto& form : reductions->alternatives(spoken, next, map, set))
+                word.alternatives.push_back(mapPhonemes(spoken, form, map, nullptr));
+        }
+        script.push_back(std::move(word));
     }
     if (script.empty())
         throw InputError("espeak-ng (voice '" + voice + "') found no words it can read in '" +
@@ -106,11 +115,12 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
                                const dsp::TemplateSet& templates,
                                const dsp::FrontEndConfig& frontEnd,
                                const dsp::AlignerConfig& aligner, const dsp::DecodeOptions& decode,
-                               const std::optional<dsp::RawFormat>& raw) {
+                               const std::optional<dsp::RawFormat>& raw, bool reductions) {
     const auto map = espeakMapForVoice(voice);
     const auto& set = PhonemeSet::named(map.phonemeSet());
     std::vector<std::string> warnings;
-    const auto script = scriptForText(synth, text, voice, map, &warnings);
+    const auto weakForms = reductions ? Reductions::forVoice(voice, map) : Reductions{};
+    const auto script = scriptForText(synth, text, voice, map, &warnings, &weakForms);
     auto result = dsp::alignFile(audio, script, templates, set, frontEnd, aligner, decode, raw);
     result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
     return result;

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,24 +69,47 @@ PhonemeMap espeakMapForVoice(const std::string& voice);
 // ---------------------------------------------------------------------------------------------
 // Known words: the script a forced alignment follows (dsp::ForcedAligner).
 
+// Common reductions of a language (config/reductions/<language>.toml): weak forms of function
+// words ("and" as /ən/ or /n/) and rules (a final t or d between consonants unsaid, a schwa
+// between consonants unsaid), which the aligner tries beside espeak-ng's careful reading.
+class Reductions {
+  public:
+    // Loads and validates a file: every phoneme must be one `map` knows (InputError names the
+    // file, line and key at fault).
+    static Reductions load(const std::filesystem::path& file, const PhonemeMap& map);
+    // The shipped file for the voice's language; none (no reductions) when there is no file.
+    static Reductions forVoice(const std::string& voice, const PhonemeMap& map);
+    // The other ways `word` may be said (espeak-ng mnemonics, durations from its reading), given
+    // the word after it (nullptr at the end); its own reading is not among them.
+    std::vector<PhonemeSchedule> alternatives(const SpokenWord& word, const SpokenWord* next,
+                                              const PhonemeMap& map, const PhonemeSet& set) const;
+
+  private:
+    std::map<std::string, std::vector<std::vector<std::string>>> words_;
+    std::vector<std::string> dropFinal_, dropBetween_;
+};
+
 // The words of `text` with their phonemes in `map`'s set and espeak-ng's durations, read by
 // espeak-ng itself (numbers, abbreviations and punctuation as it reads them). Words in a script
 // the voice cannot read (it would spell them letter by letter) are left out with a warning, so
 // the aligner treats them as unexplained speech. Throws InputError for empty text and for text
-// with no word left.
+// with no word left. With `reductions`, each word also gets its other pronunciations.
 std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::string& text,
                                            const std::string& voice, const PhonemeMap& map,
-                                           std::vector<std::string>* warnings);
+                                           std::vector<std::string>* warnings,
+                                           const Reductions* reductions = nullptr);
 
 // Aligns `text` on the speech in `audio` with the voice's phoneme map and the given front end;
 // the result says which words were placed and where the audio-only analysis stands in.
+// `reductions`: try the language's common reductions too (Reductions::forVoice).
 dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                const std::string& text, const std::string& voice,
                                const dsp::TemplateSet& templates,
                                const dsp::FrontEndConfig& frontEnd = {},
                                const dsp::AlignerConfig& aligner = {},
                                const dsp::DecodeOptions& decode = {},
-                               const std::optional<dsp::RawFormat>& raw = std::nullopt);
+                               const std::optional<dsp::RawFormat>& raw = std::nullopt,
+                               bool reductions = true);
 
 // The schedule of an audio file about to be played: aligned on `text` when given, else on the
 // words of a `FILE.txt` beside `FILE.wav` when there is one, else the audio-only analysis. Text

@@ -1,0 +1,94 @@
+// Known words over a corpus: `lipsync eval --align` (each NAME.wav aligned on NAME.txt beside
+// it, per speaker and voice) and scripts/label-with-aligner.sh (the aligner as the labeller).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <lipsyncd/core.hpp>
+#include <lipsyncd/dsp.hpp>
+#include <nlohmann/json.hpp>
+
+#include "RunLipsync.hpp"
+
+namespace lipsyncd::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// espeak-ng's speech of `text` as DIR/NAME.wav with its exact labels (NAME.lab) and, unless
+// `words` is empty, the words file NAME.txt.
+void speak(const fs::path& dir, const std::string& name, const std::string& text,
+           const std::string& voice, const std::string& words) {
+    fs::create_directories(dir);
+    const auto r =
+        runLipsync({"say", text, "--voice", voice, "--wav", (dir / (name + ".wav")).string(),
+                    "--schedule", (dir / (name + ".lab")).string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    if (!words.empty()) std::ofstream(dir / (name + ".txt")) << words << '\n';
+}
+
+TEST(AlignCli, EvalAlignScoresTheAlignedWordsPerSpeakerAndVoice) {
+    const auto dir = scratchDir("cli_eval_align");
+    const std::string en = "Seven puppets sang a song about the moon.";
+    const std::string ru = "Она завела прядь волос за ухо.";
+    speak(dir / "anna", "line", en, "en-us+f3", en);
+    speak(dir / "anna", "unscripted", en, "en-us+f3", "");  // no words file: skipped
+    speak(dir / "ivan", "line", ru, "ru", ru);
+    const auto r = runLipsync({"eval", "--corpus", dir.string(), "--align", "--voice", "ivan=ru",
+                               "--json", "-", "--no-per-file"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("no words file unscripted.txt"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("aligned on the words"), std::string::npos) << r.out;
+    const auto json = nlohmann::json::parse(r.out.substr(r.out.find("\n{") + 1));
+    EXPECT_EQ(json["files"].size(), 2u);
+    for (const auto* speaker : {"anna", "ivan"}) {
+        const auto& s = json["speakers"][speaker];
+        EXPECT_GT(s["group_accuracy"].get<double>(), 0.7) << speaker;
+        EXPECT_GT(s["jaw"]["audio"]["r"].get<double>(), 0.6) << speaker;
+    }
+    // Russian words read by the English voice are spelled, not said: far worse, or refused.
+    const auto wrong = runLipsync(
+        {"eval", "--corpus", (dir / "ivan").string(), "--align", "--json", "-", "--no-per-file"});
+    if (wrong.exitCode == 0) {
+        const auto j = nlohmann::json::parse(wrong.out.substr(wrong.out.find("\n{") + 1));
+        EXPECT_LT(j["group_accuracy"].get<double>(),
+                  json["speakers"]["ivan"]["group_accuracy"].get<double>());
+    }
+}
+
+TEST(AlignCli, EvalAlignWithoutAnyWordsFileSaysSo) {
+    const auto dir = scratchDir("cli_eval_align_none");
+    speak(dir, "line", "Open wide.", "en-us", "");
+    const auto r = runLipsync({"eval", "--corpus", dir.string(), "--align"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("NAME.txt"), std::string::npos) << r.err;
+}
+
+TEST(AlignCli, TheLabellingScriptKeepsOnlyConfidentLabels) {
+    const auto in = scratchDir("cli_label_in"), out = scratchDir("cli_label_out");
+    const std::string line = "Seven puppets sang a song about the moon.";
+    speak(in / "anna", "right", line, "en-us+f3", line);
+    speak(in / "anna", "wrong", "Moon.", "en-us+f3",
+          line + " And then another song about the sun.");
+    speak(in / "anna", "unscripted", line, "en-us+f3", "");
+    ::setenv("LIPSYNC", LIPSYNCD_LIPSYNC_BIN, 1);
+    const auto r =
+        runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh", in.string(),
+                                 out.string(), "--min-word-confidence", "0.1"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("anna: 1 files labelled (1 skipped"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(out / "anna" / "right.wav"));
+    EXPECT_FALSE(fs::exists(out / "anna" / "wrong.lab"));
+    EXPECT_FALSE(fs::exists(out / "anna" / "unscripted.lab"));
+    // The labels are the aligned schedule: close to espeak-ng's own timings.
+    const auto aligned = readScheduleFile(out / "anna" / "right.lab");
+    const auto truth = readScheduleFile(in / "anna" / "right.lab");
+    EXPECT_GT(dsp::scoreSchedule(aligned, truth, PhonemeSet::common()).groupAccuracy(), 0.75);
+    const auto usage =
+        runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh"});
+    EXPECT_EQ(usage.exitCode, 2);
+}
+
+}  // namespace
+}  // namespace lipsyncd::test
