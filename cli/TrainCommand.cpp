@@ -105,6 +105,11 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_flag("--normalise-channel", o->normaliseChannel,
                   "Subtract a running mean spectrum (channel and speaker normalisation), starting "
                   "from the training speech's mean, which the set stores");
+    cmd->add_option("--mean-prior", o->training.analysis.meanPriorSeconds,
+                    "With --normalise-channel: seconds of speech the training mean counts for "
+                    "before a voice's own mean takes over")
+        ->check(CLI::Range(0.1, 600.0))
+        ->capture_default_str();
     cmd->add_option("--description", o->description, "Description stored in the file");
     cmd->callback([o] {
         auto& a = o->training.analysis;
