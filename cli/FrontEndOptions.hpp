@@ -16,6 +16,7 @@ struct FrontEndOptions {
     dsp::SegmenterConfig segmenter;
     dsp::DecoderConfig decoder;
     std::string transitions;  // empty: the shipped default
+    dsp::ClassifierConfig classifier;
 
     void addTo(CLI::App& cmd) {
         cmd.add_option("--templates", templates,
@@ -40,6 +41,11 @@ struct FrontEndOptions {
             ->capture_default_str();
         cmd.add_option("--min-silence", segmenter.minSilenceSeconds, "Shortest silence, seconds")
             ->check(CLI::Range(0.0, 0.5))
+            ->capture_default_str();
+        cmd.add_option("--silence-below-peak", classifier.silenceBelowPeakDb,
+                       "Frames this many dB below the recent speech peak are silence, whatever "
+                       "the noise floor (0: off)")
+            ->check(CLI::Range(0.0, 80.0))
             ->capture_default_str();
         addDecoderTo(cmd);
     }
@@ -74,6 +80,7 @@ struct FrontEndOptions {
         dsp::FrontEndConfig c;
         c.segmenter = segmenter;
         c.decoder = decoder;
+        c.classifier = classifier;
         if (decoder.enabled && !transitions.empty())
             c.transitions = dsp::TransitionModel::load(findDataFile(transitions));
         if (resampler == "low") c.resamplerQuality = dsp::ResamplerQuality::Low;

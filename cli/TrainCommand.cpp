@@ -16,9 +16,36 @@ struct TrainOptions {
     dsp::TrainingOptions training;
     std::string description;
     std::vector<std::string> extraFeatures{"log_error", "level"};
+    bool normaliseChannel = false;
 };
 
-void runTrain(const TrainOptions& o) {
+// The mean spectrum of the training speech (valid frames within 30 dB of their file's peak):
+// where the channel normalisation's running mean starts (dsp::SpectrumNormaliser).
+std::vector<float> speechSpectrumMean(const TrainOptions& o) {
+    auto analysis = o.training.analysis;
+    analysis.spectrumMean.clear();
+    const auto bins = static_cast<std::size_t>(analysis.spectrumBins);
+    std::vector<double> sum(bins, 0.0);
+    std::size_t frames = 0;
+    for (const auto& dir : o.corpora)
+        for (const auto& item : listCorpus(dir, nullptr)) {
+            const auto features = dsp::analyzeFrames(item.audio, analysis);
+            float peak = -120;
+            for (const auto& f : features) peak = std::max(peak, f.energyDb);
+            for (const auto& f : features)
+                if (f.valid && f.energyDb >= peak - 30) {
+                    for (std::size_t b = 0; b < bins; ++b) sum[b] += f.spectrum[b];
+                    ++frames;
+                }
+        }
+    if (frames == 0) throw InputError("training: no speech frames for the channel mean");
+    std::vector<float> mean(bins);
+    for (std::size_t b = 0; b < bins; ++b) mean[b] = static_cast<float>(sum[b] / frames);
+    return mean;
+}
+
+void runTrain(TrainOptions o) {
+    if (o.normaliseChannel) o.training.analysis.spectrumMean = speechSpectrumMean(o);
     const auto& set = PhonemeSet::common();
     dsp::TemplateTrainer trainer(o.training, set);
     std::size_t files = 0;
@@ -74,6 +101,14 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_option("--extra-features", o->extraFeatures,
                     "Features after the spectrum: log_error, level (comma list, or 'none')")
         ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_flag("--normalise-channel", o->normaliseChannel,
+                  "Subtract a running mean spectrum (channel and speaker normalisation), starting "
+                  "from the training speech's mean, which the set stores");
+    cmd->add_option("--mean-prior", o->training.analysis.meanPriorSeconds,
+                    "With --normalise-channel: seconds of speech the training mean counts for "
+                    "before a voice's own mean takes over")
+        ->check(CLI::Range(0.1, 600.0))
         ->capture_default_str();
     cmd->add_option("--description", o->description, "Description stored in the file");
     cmd->callback([o] {

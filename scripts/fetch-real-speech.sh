@@ -31,6 +31,8 @@ while read -r speaker kind source; do
                 packages+=("asterisk-core-sounds-$lang-wav" "asterisk-core-sounds-$lang") ;;
     klettres:*) packages+=(klettres-data) ;;
     ktuberling:*) packages+=(ktuberling-data) ;;
+    fillets:*) lang="${source#fillets:}" lang="${lang%%:*}"
+               packages+=(fillets-ng-data "fillets-ng-data-$lang") ;;
     festvox-ru) packages+=(festvox-ru) ;;
     *) echo "fetch-real-speech.sh: $speaker: unknown source '$source'" >&2; exit 1 ;;
   esac

@@ -15,6 +15,11 @@ Labels:
   decoder's word times are phone times. Phones map to the common set by config/phonemes/arpabet.toml.
 - words known in Italian or Spanish (asterisk prompts): the same aligner, each word spelled in
   the nearest English phones from espeak-ng's phonemisation (config/corpus/espeak-arpabet.toml).
+- fillets-ng (Czech, Dutch): the game's dialogue clips, whose words are in its scripts
+  (script/LEVEL/dialogs_LANG.lua, keyed by clip name); one voice a speaker, by the clip name's
+  middle part (`v` the big fish, a man; `m` the small fish, a woman); aligned as the asterisk
+  prompts of other languages are. At most FILLETS_MAX_ITEMS clips a voice (sorted by name): the
+  labelling time stays bounded and the voice still outweighs none of the others.
 - festvox-ru: the voice's own time-aligned phone labels (lab/*.lab), mapped by
   config/phonemes/festvox-ru.toml.
 Items whose words are not in the dictionary, or that the aligner cannot fit, are skipped and
@@ -102,6 +107,28 @@ def ktuberling_items(root, lang):
             yield audio.stem, audio, words[audio.stem], None, " ".join(words[audio.stem])
 
 
+FILLETS_MAX_ITEMS = 300
+
+
+def fillets_items(root, lang, voice):
+    base = root / "usr/share/games/fillets-ng"
+    items = []
+    for script in sorted((base / "script").glob(f"*/dialogs_{lang}.lua")):
+        level = script.parent.name
+        key = None
+        for line in script.read_text(encoding="utf-8").splitlines():
+            if m := re.match(r'\s*dialogId\("([^"]+)"', line):
+                key = m.group(1)
+            elif (m := re.match(r'\s*dialogStr\("(.*)"\)\s*$', line)) and key:
+                parts = key.split("-")
+                audio = base / "sound" / level / lang / f"{key}.ogg"
+                if len(parts) >= 3 and parts[1] == voice and audio.exists():
+                    items.append((f"{level}_{key}", audio, m.group(1).replace('\\"', '"')))
+                key = None
+    for name, audio, text in sorted(items)[:FILLETS_MAX_ITEMS]:
+        yield name, audio, ("espeak", lang, text), None
+
+
 def festvox_ru_items(root):
     base = root / "usr/share/festival/voices/russian/msu_ru_nsh_clunits"
     phones = load_map("festvox-ru")
@@ -132,6 +159,8 @@ def items_of(root, source):
         return klettres_items(root, *args)
     if kind == "ktuberling":
         return ktuberling_items(root, *args)
+    if kind == "fillets":
+        return fillets_items(root, *args)
     if kind == "festvox-ru":
         return festvox_ru_items(root)
     sys.exit(f"config/corpus/real-speakers.txt: unknown source '{source}'")
@@ -149,14 +178,15 @@ def load_dictionary():
 
 def espeak_spelling(lang, text):
     """Per word, the one pronunciation espeak-ng gives, in ARPAbet (config/corpus/espeak-arpabet.toml)."""
-    table = tomllib.loads((HERE / "config/corpus/espeak-arpabet.toml").read_text())["map"]
+    doc = tomllib.loads((HERE / "config/corpus/espeak-arpabet.toml").read_text())
+    table = doc["map"] | doc.get("lang", {}).get(lang, {})
     out = subprocess.run(["espeak-ng", "-q", "-x", "--sep= ", "-v", lang, text],
                          capture_output=True, text=True, check=True).stdout
     words = []
     for word in re.split(r"\s{2,}|\n", out):
         phones = []
         for token in word.split():
-            token = re.sub(r"[',:;]", "", token)
+            token = re.sub(r"[',:;]|\(\w+\)", "", token)  # stress, length; (en) language switches
             if not token or token.startswith("_"):
                 continue
             if token not in table:

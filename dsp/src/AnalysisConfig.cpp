@@ -29,6 +29,17 @@ void AnalysisConfig::validate() const {
     if (spectrumBins < 4 || spectrumBins > 512) bad("bins", "must be 4..512");
     if (spectrumByFft && (spectrumBins & (spectrumBins - 1)) != 0)
         bad("bins", "must be a power of two for FFT evaluation");
+    if (!spectrumMean.empty()) {
+        if (spectrumMean.size() != static_cast<std::size_t>(spectrumBins))
+            bad("spectrum_mean", "must have one value per bin (" + std::to_string(spectrumBins) +
+                                     "), has " + std::to_string(spectrumMean.size()));
+        for (const float v : spectrumMean)
+            if (!std::isfinite(v)) bad("spectrum_mean", "must be finite numbers");
+        if (!(meanPriorSeconds > 0 && meanPriorSeconds <= 600))
+            bad("mean_prior_seconds", "must be in (0, 600] s");
+        if (!(meanMemorySeconds >= meanPriorSeconds && meanMemorySeconds <= 3600))
+            bad("mean_memory_seconds", "must be at least mean_prior_seconds and at most 3600 s");
+    }
     if (!(levelPeakDecayDbPerSecond > 0)) bad("level_peak_decay", "must be > 0 dB/s");
 }
 

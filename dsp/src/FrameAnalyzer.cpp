@@ -37,6 +37,7 @@ FrameAnalyzer::FrameAnalyzer(const AnalysisConfig& config) : config_(config) {
         fft_ = std::make_unique<FftLpcSpectrum>(config_.spectrumBins);
     else
         direct_ = std::make_unique<DirectLpcSpectrum>(config_.order, config_.spectrumBins);
+    if (!config_.spectrumMean.empty()) normaliser_.emplace(config_);
 }
 
 FrameAnalyzer::FrameAnalyzer(FrameAnalyzer&&) noexcept = default;
@@ -84,6 +85,7 @@ void FrameAnalyzer::analyze(std::span<const float> frame, FrameFeatures& out) {
         fft_->evaluate(std::span<const float>(out.lpc.a.data(), p + 1), spectrum);
     else
         direct_->evaluate(std::span<const float>(out.lpc.a.data(), p + 1), spectrum);
+    if (normaliser_) normaliser_->apply(out);
     addExtraFeatures(out);
 }
 

@@ -31,6 +31,7 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
 
 void FrameClassifier::reset() {
     noiseFloorDb_ = kInitialNoiseFloorDb;
+    peakDb_ = -120;
     floorInitialised_ = false;
     lastTime_ = 0;
 }
@@ -56,7 +57,12 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
             std::min(kMaxNoiseFloorDb,
                      noiseFloorDb_ + config_.noiseFloorRiseDbPerSecond * static_cast<float>(dt));
     label.noiseFloorDb = noiseFloorDb_;
-    const float gate = std::max(config_.absoluteSilenceDb, noiseFloorDb_ + config_.silenceMarginDb);
+    float gate = std::max(config_.absoluteSilenceDb, noiseFloorDb_ + config_.silenceMarginDb);
+    if (config_.silenceBelowPeakDb > 0) {
+        peakDb_ = std::max(frame.energyDb,
+                           peakDb_ - config_.peakDecayDbPerSecond * static_cast<float>(dt));
+        gate = std::max(gate, peakDb_ - config_.silenceBelowPeakDb);
+    }
 
     // Distances: weighted RMS difference in dB to the nearest template of each class.
     std::fill(distances_.begin(), distances_.end(), std::numeric_limits<float>::infinity());

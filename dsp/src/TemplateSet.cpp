@@ -39,6 +39,12 @@ AnalysisConfig readAnalysis(const json& a, const std::string& source) {
         if (c.levelFeature)
             c.levelPeakDecayDbPerSecond = member<double>(a, "level_peak_decay", p, source);
     }
+    // Optional: the channel normalisation's starting mean (AnalysisConfig::spectrumMean).
+    if (a.contains("spectrum_mean")) {
+        c.spectrumMean = member<std::vector<float>>(a, "spectrum_mean", p, source);
+        c.meanPriorSeconds = member<double>(a, "mean_prior_seconds", p, source);
+        c.meanMemorySeconds = member<double>(a, "mean_memory_seconds", p, source);
+    }
     try {
         c.validate();
     } catch (const InputError& e) {
@@ -46,6 +52,8 @@ AnalysisConfig readAnalysis(const json& a, const std::string& source) {
     }
     return c;
 }
+
+std::vector<double> rounded(const std::vector<float>& v);
 
 json writeAnalysis(const AnalysisConfig& c) {
     json a = {{"rate", c.analysisRate},
@@ -61,6 +69,11 @@ json writeAnalysis(const AnalysisConfig& c) {
     if (c.levelFeature) {
         extra.push_back("level");
         a["level_peak_decay"] = c.levelPeakDecayDbPerSecond;
+    }
+    if (!c.spectrumMean.empty()) {
+        a["spectrum_mean"] = rounded(c.spectrumMean);
+        a["mean_prior_seconds"] = c.meanPriorSeconds;
+        a["mean_memory_seconds"] = c.meanMemorySeconds;
     }
     return a;
 }
