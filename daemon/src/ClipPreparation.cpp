@@ -51,6 +51,10 @@ Clip prepareClip(const ClipRequest& request, std::unique_ptr<EspeakSynthesizer>&
     if (seconds > request.maxSeconds)
         throw InputError(std::to_string(seconds) + " s is longer than max_clip_seconds");
     clip.name = request.name;
+    // Held until played: no spare capacity (the weights grew frame by frame).
+    clip.samples.shrink_to_fit();
+    clip.weights.times.shrink_to_fit();
+    clip.weights.values.shrink_to_fit();
     return clip;
 }
 

@@ -91,12 +91,14 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
 // words of a `FILE.txt` beside `FILE.wav` when there is one, else the audio-only analysis. Text
 // that cannot be aligned (empty, unreadable) falls back to the audio-only analysis. `log` gets
 // one line saying which was used, and the alignment's warnings. For the service's clip
-// preparation.
+// preparation; `levels`, when given, gets the analysis's frame levels (the loudness shaping's
+// input, so the caller need not read the audio a second time).
 PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                 const std::optional<std::string>& text, const std::string& voice,
                                 const dsp::TemplateSet& templates,
                                 const dsp::DecodeOptions& decode,
-                                const std::function<void(const std::string&)>& log);
+                                const std::function<void(const std::string&)>& log,
+                                LevelTrack* levels = nullptr);
 
 // The words file beside an audio file (FILE.wav → FILE.txt), if there is one.
 std::optional<std::filesystem::path> wordsBeside(const std::filesystem::path& audio);
