@@ -93,9 +93,12 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
 }
 
 Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
-                         const std::string& voice) const {
+                         const std::string& voice, double maxSeconds) const {
     const auto v = voice.empty() ? impl_->config.voice : voice;
-    auto speech = synth.synthesize({text, v, 0, -1});
+    auto speech = synth.synthesize({text, v, 0, -1, maxSeconds});
+    if (speech.truncated)
+        throw InputError("the speech is longer than max_clip_seconds (" +
+                         std::to_string(maxSeconds) + " s in the config)");
     Clip clip;
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;

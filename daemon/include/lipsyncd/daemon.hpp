@@ -160,8 +160,10 @@ class ClipMaker {
                   const std::optional<std::string>& knownText = std::nullopt,
                   const std::function<void(const std::string&)>& log = {}) const;
     // espeak-ng allows one synthesiser per process, for the process's life: the daemon owns it.
-    Clip fromText(EspeakSynthesizer& synth, const std::string& text,
-                  const std::string& voice) const;
+    // Speech longer than `maxSeconds` (0: no limit) is an InputError, found without ever
+    // holding more than that much of it.
+    Clip fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice,
+                  double maxSeconds = 0) const;
     const std::vector<std::string>& poseNames() const;
     // The live path: front end and runtime in their streaming forms (causal: least delay).
     class Live;

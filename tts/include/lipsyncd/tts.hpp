@@ -19,6 +19,9 @@ struct SynthesisRequest {
     std::string voice = "en-us";  // any espeak-ng voice, variants with '+', e.g. "en-us+f2"
     int wordsPerMinute = 0;       // 0: the voice's default (175)
     int pitch = -1;               // 0..100, -1: default
+    // 0: no limit. Otherwise speech stops there (`truncated` says so), and no more than this
+    // is ever held: the service's max_clip_seconds bounds its memory and the worker's time.
+    double maxSeconds = 0;
 };
 
 // One word of the text as espeak-ng read it: a number may become several spoken words, all
@@ -36,6 +39,7 @@ struct SynthesizedSpeech {
     PhonemeSchedule phonemes;
     // The same phonemes by written word (espeak-ng's word events).
     std::vector<SpokenWord> words;
+    bool truncated = false;  // the text was longer than the request's maxSeconds
 };
 
 // espeak-ng holds global state, so one synthesiser exists at a time (a second throws).
