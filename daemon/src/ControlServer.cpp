@@ -156,7 +156,7 @@ nlohmann::json ControlServer::reply(const std::string& line, bool& subscribed,
     nlohmann::json request;
     try {
         request = nlohmann::json::parse(line);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number like 1e600
         return {{"ok", false}, {"error", std::string("not JSON: ") + e.what()}};
     }
     if (const auto bad = checkControlRequest(request)) return {{"ok", false}, {"error", *bad}};

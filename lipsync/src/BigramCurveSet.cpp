@@ -18,7 +18,7 @@ json readJson(const std::filesystem::path& file) {
     if (!in) throw InputError(file.string() + ": cannot open");
     try {
         return json::parse(in);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // bad syntax, or a number out of range (1e600)
         throw InputError(file.string() + ": not valid JSON (" + e.what() + ")");
     }
 }
@@ -180,7 +180,7 @@ void BigramCurveSet::applyBigramsJson(std::string_view bigramsJson, const std::s
     json j;
     try {
         j = json::parse(bigramsJson);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // bad syntax, or a number out of range
         throw InputError(source + ": not valid JSON (" + e.what() + ")");
     }
     readBigrams(j, source, poses, phonemes, *this);
