@@ -21,7 +21,7 @@ struct AnimateOptions {
 
 void runAnimate(const AnimateOptions& o) {
     const auto schedule = readLabels(o.schedule, o.labels, &o.runtime.phonemeSet());
-    if (o.delay >= 0 && o.runtime.runtime != "bigram")
+    if (o.delay >= 0 && o.runtime.spec.kind != "bigram")
         throw CLI::ValidationError("--delay", "streaming is for --runtime bigram");
     if (o.delay < 0) {
         std::optional<LevelTrack> levels;
@@ -35,9 +35,8 @@ void runAnimate(const AnimateOptions& o) {
     if (!o.audio.empty())
         throw CLI::ValidationError("--audio", "loudness shaping is for offline runs (no --delay)");
     // Streaming, as the daemon runs it: segment by segment, with the given delay.
-    const auto loaded = o.runtime.load();
-    lipsync::StreamingRuntime stream(loaded.curves, loaded.poses, o.delay, o.runtime.config,
-                                     o.runtime.phonemeSet());
+    const auto runtime = o.runtime.load();
+    auto stream = runtime.streaming(o.delay);
     PoseTrack track;
     for (const auto& s : schedule) stream.push(s, track);
     stream.finish(track);

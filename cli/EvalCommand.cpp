@@ -64,7 +64,7 @@ struct Evaluator {
     const EvalOptions& o;
     const PhonemeSet& set = PhonemeSet::common();
     dsp::TemplateSet templates = o.frontEnd.loadTemplates();
-    RuntimeOptions::Loaded runtime = o.runtime.load();
+    lipsync::Runtime runtime = o.runtime.load();
     std::optional<PuppetJaw> puppet;
     std::unique_ptr<EspeakSynthesizer> synth;  // --align: reads the words
 
@@ -75,10 +75,11 @@ struct Evaluator {
 
     // The pose track an envelope follower makes: its value on the jaw pose, nothing else.
     PoseTrack envelopeTrack(const LevelTrack& levels) const {
-        const auto jawPose = runtime.poses.find("jaw");
-        if (!jawPose) throw InputError("pose set '" + runtime.poses.name() + "' has no 'jaw' pose");
+        const auto jawPose = runtime.poses().find("jaw");
+        if (!jawPose)
+            throw InputError("pose set '" + runtime.poses().name() + "' has no 'jaw' pose");
         PoseTrack track;
-        track.poses = runtime.poses.names();
+        track.poses = runtime.poses().names();
         std::vector<float> row(track.poses.size(), 0.0f);
         const auto envelope = dsp::followEnvelope(levels);
         for (std::size_t f = 0; f < envelope.size(); ++f) {
@@ -100,8 +101,8 @@ struct Evaluator {
         // does; the envelope follower, like a jaw board, hears the audio itself.
         const auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
         const auto heard = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
-        return {score(o.runtime.animate(schedule, runtime, &levels)),
-                score(o.runtime.animate(reference, runtime, &levels)), score(envelopeTrack(heard))};
+        return {score(runtime.animate(schedule, &levels)),
+                score(runtime.animate(reference, &levels)), score(envelopeTrack(heard))};
     }
 
     // The voice whose reading of the words a speaker's files are aligned with.

@@ -67,10 +67,7 @@ struct FrontEndOptions {
                        "config/decoder/english-transitions.json)");
     }
 
-    dsp::TemplateSet loadTemplates() const {
-        return templates.empty() ? dsp::TemplateSet::loadDefault()
-                                 : dsp::TemplateSet::load(findDataFile(templates));
-    }
+    dsp::TemplateSet loadTemplates() const { return dsp::TemplateSet::named(templates); }
     dsp::DecodeOptions decode() const { return {channel}; }
     std::optional<dsp::RawFormat> raw() const {
         if (rawSpec.empty()) return std::nullopt;

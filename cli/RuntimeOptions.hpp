@@ -4,7 +4,6 @@
 
 #include <CLI/CLI.hpp>
 #include <lipsyncd/lipsync.hpp>
-#include <memory>
 #include <string>
 
 #include "Output.hpp"
@@ -12,75 +11,49 @@
 namespace lipsyncd::cli {
 
 struct RuntimeOptions {
-    std::string weights;  // where to write pose weights (CSV); empty: not asked for
-    std::string poses = "facefx";
-    std::string curves = "english";
-    std::string character;
-    std::string runtime = "bigram";
-    std::string phonemes = "common";
-    lipsync::RuntimeConfig config;
-    bool loudness = true;  // shape poses by the speech level where the audio is known
+    std::string weights;        // where to write pose weights (CSV); empty: not asked for
+    lipsync::RuntimeSpec spec;  // what lipsyncd's [mouth] table says too
 
     // `withWeights`: add --weights (commands whose main output is something else).
     void addTo(CLI::App& cmd, bool withWeights) {
         if (withWeights)
             cmd.add_option("--weights", weights,
                            "Write mouth-pose weights here (CSV, '-' for stdout)");
-        cmd.add_option("--poses", poses, "Pose set (config/poses/NAME.toml, or a file)")
+        cmd.add_option("--poses", spec.poses, "Pose set (config/poses/NAME.toml, or a file)")
             ->capture_default_str();
-        cmd.add_option("--curves", curves, "Bigram curve set (config/curves/NAME.json, or a file)")
+        cmd.add_option("--curves", spec.curves,
+                       "Bigram curve set (config/curves/NAME.json, or a file)")
             ->capture_default_str();
-        cmd.add_option("--runtime", runtime,
+        cmd.add_option("--runtime", spec.kind,
                        "bigram: the phone-bigram curves (paper 000); filter: the viseme-space "
                        "filter (paper 001, section 5), simpler and lower-latency")
             ->check(CLI::IsMember({"bigram", "filter"}))
             ->capture_default_str();
         cmd.add_option(
-               "--phonemes", phonemes,
+               "--phonemes", spec.phonemes,
                "Phoneme set of the schedule and curves: common, mandarin (common + ü), or a file")
             ->capture_default_str();
-        cmd.add_option("--character", character,
+        cmd.add_option("--character", spec.character,
                        "Character file: a base curve set with some bigrams replaced");
-        cmd.add_option("--weights-rate", config.outputRate, "Pose-weight frames per second")
+        cmd.add_option("--weights-rate", spec.config.outputRate, "Pose-weight frames per second")
             ->check(CLI::Range(1.0, 1000.0))
             ->capture_default_str();
-        cmd.add_flag("!--no-smoothing", config.smoothing, "Skip valley smoothing (for comparison)");
-        cmd.add_flag("!--no-constraints", config.constraints, "Skip pose-pair constraints");
-        cmd.add_flag("!--no-speed-limits", config.speedLimits, "Skip speed limits");
-        cmd.add_flag("!--no-rest", config.restInPauses,
+        cmd.add_flag("!--no-smoothing", spec.config.smoothing,
+                     "Skip valley smoothing (for comparison)");
+        cmd.add_flag("!--no-constraints", spec.config.constraints, "Skip pose-pair constraints");
+        cmd.add_flag("!--no-speed-limits", spec.config.speedLimits, "Skip speed limits");
+        cmd.add_flag("!--no-rest", spec.config.restInPauses,
                      "Do not force the mouth to rest in pauses and after speech");
-        cmd.add_flag("!--no-loudness", loudness,
+        cmd.add_flag("!--no-loudness", spec.loudness,
                      "Do not let louder speech open the mouth wider (poses' loudness_gain)");
     }
 
-    struct Loaded {
-        lipsync::PoseSet poses;
-        lipsync::BigramCurveSet curves;
-    };
-    const PhonemeSet& phonemeSet() const { return PhonemeSet::named(phonemes); }
+    const PhonemeSet& phonemeSet() const { return PhonemeSet::named(spec.phonemes); }
+    lipsync::Runtime load() const { return lipsync::Runtime(spec); }
 
-    Loaded load() const {
-        auto poseSet = lipsync::PoseSet::named(poses);
-        auto set = character.empty() ? lipsync::BigramCurveSet::named(curves, poseSet, phonemeSet())
-                                     : lipsync::BigramCurveSet::load(findDataFile(character),
-                                                                     poseSet, phonemeSet());
-        return {std::move(poseSet), std::move(set)};
-    }
-
-    // The runtime over a schedule; with `levels` (the speech's frame levels) and loudness on,
-    // louder speech opens wider within what each phoneme allows.
-    PoseTrack animate(const PhonemeSchedule& schedule, const Loaded& loaded,
-                      const LevelTrack* levels = nullptr) const {
-        auto track =
-            runtime == "filter"
-                ? lipsync::animateFilter(schedule, loaded.curves, loaded.poses, config,
-                                         phonemeSet())
-                : lipsync::animate(schedule, loaded.curves, loaded.poses, config, phonemeSet());
-        if (levels && loudness) lipsync::shapeByLoudness(loaded.poses, *levels, track);
-        return track;
-    }
+    // The runtime over a schedule, loaded for this one call.
     PoseTrack animate(const PhonemeSchedule& schedule, const LevelTrack* levels = nullptr) const {
-        return animate(schedule, load(), levels);
+        return load().animate(schedule, levels);
     }
 
     void writeWeights(const PoseTrack& track) const {

@@ -20,4 +20,4 @@ cmake --build build-fuzz -j"$(nproc)" --target "fuzz_$target"
 mkdir -p "build-fuzz/corpus-$target"
 cd build-fuzz
 LSAN_OPTIONS="suppressions=$PWD/../fuzz/lsan.supp" LIPSYNCD_DATA_DIR="$PWD/../config" "./fuzz/fuzz_$target" "corpus-$target" "$seeds" \
-  -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -print_final_stats=1 2>&1 | tail -n 15
+  -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -print_final_stats=1 2>&1 | grep -v "# Uses:" | tail -n 15

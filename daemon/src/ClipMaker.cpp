@@ -8,38 +8,34 @@
 #include <lipsyncd/dsp.hpp>
 #include <lipsyncd/lipsync.hpp>
 #include <lipsyncd/tts.hpp>
+#include <optional>
 
 namespace lipsyncd::daemon {
 
+namespace {
+constexpr int kMaxPlaybackRate = 48000;  // what any sound card plays; above is resampled
+}  // namespace
+
 struct ClipMaker::Impl {
     DaemonConfig config;
-    lipsync::PoseSet poses;
-    lipsync::BigramCurveSet curves;
+    lipsync::Runtime runtime;  // built as `lipsync animate` builds it
     dsp::TemplateSet templates;
     std::vector<std::string> poseNames;
 
     explicit Impl(const DaemonConfig& c)
         : config(c),
-          poses(lipsync::PoseSet::named(c.poses)),
-          curves(c.character.empty()
-                     ? lipsync::BigramCurveSet::named(c.curves, poses)
-                     : lipsync::BigramCurveSet::load(findDataFile(c.character), poses)),
-          templates(c.templates.empty() ? dsp::TemplateSet::loadDefault()
-                                        : dsp::TemplateSet::load(findDataFile(c.templates))),
-          poseNames(poses.names()) {}
-
-    // The mouth for a schedule, opened as wide as the speech (its `levels`) is loud.
-    PoseTrack animate(const PhonemeSchedule& s, const LevelTrack& levels) const {
-        lipsync::RuntimeConfig rc;
-        rc.outputRate = config.outputRateHz;
-        auto track = config.runtime == "filter" ? lipsync::animateFilter(s, curves, poses, rc)
-                                                : lipsync::animate(s, curves, poses, rc);
-        lipsync::shapeByLoudness(poses, levels, track);
-        return track;
-    }
+          runtime(c.runtime),
+          templates(dsp::TemplateSet::named(c.templates)),
+          poseNames(runtime.poses().names()) {}
 };
 
-ClipMaker::ClipMaker(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+ClipMaker::ClipMaker(const DaemonConfig& config) {
+    try {
+        impl_ = std::make_unique<Impl>(config);
+    } catch (const InputError& e) {  // which key of the config named what failed to load
+        throw InputError(config.source.string() + ": [mouth] " + e.what());
+    }
+}
 ClipMaker::~ClipMaker() = default;
 
 const std::vector<std::string>& ClipMaker::poseNames() const {
@@ -48,18 +44,29 @@ const std::vector<std::string>& ClipMaker::poseNames() const {
 
 namespace {
 // The sound to play, decoded a block at a time straight into 16-bit samples: no float copy
-// of the whole file is ever held (memory with a full queue of long clips).
+// of the whole file is ever held (memory with a full queue of long clips). Above 48 kHz it is
+// resampled to 48 kHz: what one clip may hold is then bounded by max_clip_seconds alone.
 std::vector<std::int16_t> decodeForPlayback(const std::filesystem::path& file,
                                             const dsp::DecodeOptions& options, int& rate) {
     auto decoder = dsp::AudioDecoder::open(file, options);
-    rate = decoder.sampleRate();
+    rate = std::min(decoder.sampleRate(), kMaxPlaybackRate);
+    std::optional<dsp::StreamResampler> resampler;
+    if (rate != decoder.sampleRate()) resampler.emplace(decoder.sampleRate(), rate);
     std::vector<std::int16_t> out;
-    out.reserve(static_cast<std::size_t>(decoder.frames().value_or(0)));
+    out.reserve(static_cast<std::size_t>(static_cast<double>(decoder.frames().value_or(0)) * rate /
+                                         decoder.sampleRate()) +
+                1);
+    const auto append = [&](std::span<const float> block) {
+        for (const float v : block)
+            out.push_back(
+                static_cast<std::int16_t>(std::lround(std::clamp(v, -1.0f, 1.0f) * 32767.0f)));
+    };
     std::array<float, 4096> block{};
-    while (const auto n = decoder.read(block))
-        for (std::size_t i = 0; i < n; ++i)
-            out.push_back(static_cast<std::int16_t>(
-                std::lround(std::clamp(block[i], -1.0f, 1.0f) * 32767.0f)));
+    while (const auto n = decoder.read(block)) {
+        const auto in = std::span<const float>(block).first(n);
+        resampler ? append(resampler->process(in)) : append(in);
+    }
+    if (resampler) append(resampler->process({}, true));
     return out;
 }
 }  // namespace
@@ -72,16 +79,13 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
     Clip clip;
     clip.name = file.string();
     // Analysed on `channel` (the voice), played on the others (what the audience hears); the
-    // analysis first, so its buffers are gone before the sound's is made.
+    // analysis first, so its buffers are gone before the sound's is made. The mouth opens as
+    // wide as the voice is loud: the analysis's own levels (as `lipsync analyze --weights`).
+    LevelTrack levels;
     const auto schedule = scheduleForClip(
         synth, file, knownText, impl_->config.voice, impl_->templates, decode,
-        log ? log : [](const auto&) {});
-    {
-        // The mouth opens as wide as the voice is loud: its samples, gone before the sound's.
-        const auto voice = dsp::readAudioFile(file, decode);
-        clip.weights =
-            impl_->animate(schedule, dsp::measureLevels(voice.samples, voice.sampleRate));
-    }
+        log ? log : [](const auto&) {}, &levels);
+    clip.weights = impl_->runtime.animate(schedule, &levels);
     dsp::DecodeOptions play;
     play.skipChannel = channel;
     clip.samples = decodeForPlayback(file, play, clip.rate);
@@ -89,15 +93,19 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
 }
 
 Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
-                         const std::string& voice) const {
+                         const std::string& voice, double maxSeconds) const {
     const auto v = voice.empty() ? impl_->config.voice : voice;
-    const auto speech = synth.synthesize({text, v, 0, -1});
+    auto speech = synth.synthesize({text, v, 0, -1, maxSeconds});
+    if (speech.truncated)
+        throw InputError("the speech is longer than max_clip_seconds (" +
+                         std::to_string(maxSeconds) + " s in the config)");
     Clip clip;
     clip.name = "say: " + text;
     clip.rate = speech.sampleRate;
-    clip.samples = speech.samples;
-    clip.weights = impl_->animate(mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr),
-                                  dsp::measureLevels(speech.samples, speech.sampleRate));
+    const auto levels = dsp::measureLevels(speech.samples, speech.sampleRate);
+    clip.samples = std::move(speech.samples);
+    clip.weights = impl_->runtime.animate(
+        mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr), &levels);
     return clip;
 }
 
@@ -110,11 +118,11 @@ namespace {
 // up to the last closed phoneme go out as soon as the phoneme closes.
 class StreamingLive : public ClipMaker::Live {
   public:
-    StreamingLive(const dsp::TemplateSet& templates, const lipsync::BigramCurveSet& curves,
-                  const lipsync::PoseSet& poses, double outputRate, int rate)
+    StreamingLive(const dsp::TemplateSet& templates, const lipsync::Runtime& runtime, int rate)
         : analyzer_(templates, PhonemeSet::common(), rate),
-          runtime_(curves, poses, 0, config(outputRate)),
-          shaper_(poses) {
+          runtime_(runtime.streaming(0)),
+          shaper_(runtime.poses()),
+          loudness_(runtime.spec().loudness) {
         analyzer_.onSegment([this](const PhonemeSegment& s) { runtime_.push(s, *out_); });
         // The newest frame's class stands for the phoneme still open (the segmenter has not
         // closed it yet): the mouth starts moving without waiting for the phoneme to end.
@@ -128,7 +136,7 @@ class StreamingLive : public ClipMaker::Live {
         out_ = &out;
         analyzer_.push(samples);
         if (!openPhoneme_.empty()) runtime_.preview(openPhoneme_, openUntil_, out);
-        shapeNewFrames(out);
+        if (loudness_) shapeNewFrames(out);
     }
     double latencySeconds() const override { return analyzer_.latencySeconds(); }
 
@@ -150,14 +158,10 @@ class StreamingLive : public ClipMaker::Live {
             shapedUntil_ = t;
         }
     }
-    static lipsync::RuntimeConfig config(double rate) {
-        lipsync::RuntimeConfig c;
-        c.outputRate = rate;
-        return c;
-    }
     dsp::StreamingAnalyzer analyzer_;
     lipsync::StreamingRuntime runtime_;
     lipsync::LoudnessShaper shaper_;
+    bool loudness_;
     PoseTrack* out_ = nullptr;
     std::string openPhoneme_;
     double openUntil_ = 0;
@@ -172,8 +176,7 @@ class StreamingLive : public ClipMaker::Live {
 }  // namespace
 
 std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
-    return std::make_unique<StreamingLive>(impl_->templates, impl_->curves, impl_->poses,
-                                           impl_->config.outputRateHz, rate);
+    return std::make_unique<StreamingLive>(impl_->templates, impl_->runtime, rate);
 }
 
 }  // namespace lipsyncd::daemon

@@ -45,12 +45,20 @@ Clip prepareClip(const ClipRequest& request, std::unique_ptr<EspeakSynthesizer>&
         clip = request.maker->fromFile(request.file, request.channel, *synth, request.knownText,
                                        logInfo);
     } else {
-        clip = request.maker->fromText(*synth, request.text, request.voice);
+        clip = request.maker->fromText(*synth, request.text, request.voice, request.maxSeconds);
     }
     const double seconds = static_cast<double>(clip.samples.size()) / clip.rate;
     if (seconds > request.maxSeconds)
         throw InputError(std::to_string(seconds) + " s is longer than max_clip_seconds");
     clip.name = request.name;
+    // Held until played: no spare capacity (the weights grew frame by frame). Shrinking
+    // copies, so a buffer within 2 % of its size (the audio, reserved ahead) is left as it is.
+    const auto compact = [](auto& v) {
+        if (v.capacity() - v.size() > v.size() / 50) v.shrink_to_fit();
+    };
+    compact(clip.samples);
+    compact(clip.weights.times);
+    compact(clip.weights.values);
     return clip;
 }
 

@@ -85,6 +85,26 @@ bool ClipQueue::empty() const {
     return jobs_.empty();
 }
 
+std::size_t bytesOf(const Clip& clip) {
+    const auto& w = clip.weights;
+    std::size_t names = clip.name.capacity();
+    for (const auto& p : w.poses) names += sizeof p + p.capacity();
+    return sizeof clip + names + clip.samples.capacity() * sizeof(std::int16_t) +
+           w.values.capacity() * sizeof(float) + w.times.capacity() * sizeof(double);
+}
+
+std::size_t ClipQueue::bytesHeld() const {
+    std::lock_guard lock(mutex_);
+    std::size_t bytes = 0;
+    for (const auto& j : jobs_) {
+        const auto& r = j.request;
+        bytes += sizeof j + r.name.capacity() + r.file.native().capacity() + r.text.capacity() +
+                 r.voice.capacity() + (r.knownText ? r.knownText->capacity() : 0);
+        if (j.clip) bytes += bytesOf(*j.clip);
+    }
+    return bytes;
+}
+
 std::vector<std::string> ClipQueue::takeFailures() {
     std::lock_guard lock(mutex_);
     return std::exchange(failures_, {});

@@ -45,6 +45,9 @@ class ClipQueue {
     std::size_t capacity() const;
     std::vector<std::string> names() const;  // what waits, in order
     bool empty() const;
+    // Bytes the waiting requests and the clip made ready ahead hold (the queue's memory: one
+    // prepared clip at most, however long the queue).
+    std::size_t bytesHeld() const;
     // Requests whose preparation failed since the last call: "NAME: why".
     std::vector<std::string> takeFailures();
 
@@ -65,6 +68,9 @@ class ClipQueue {
     bool stopping_ = false;
     std::thread worker_;  // last: started when everything above exists
 };
+
+// Bytes a clip's audio and weights hold.
+std::size_t bytesOf(const Clip& clip);
 
 // Request-time checks (cheap: a stat and an audio header). InputError saying what is wrong.
 double checkAudioFile(const std::filesystem::path& file, double maxSeconds);  // its duration

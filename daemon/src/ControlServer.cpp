@@ -156,7 +156,7 @@ nlohmann::json ControlServer::reply(const std::string& line, bool& subscribed,
     nlohmann::json request;
     try {
         request = nlohmann::json::parse(line);
-    } catch (const nlohmann::json::exception& e) {  // parse_error, and 1e999's out_of_range
+    } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number like 1e600
         return {{"ok", false}, {"error", std::string("not JSON: ") + e.what()}};
     }
     if (const auto bad = checkControlRequest(request)) return {{"ok", false}, {"error", *bad}};
@@ -225,16 +225,24 @@ void ControlServer::flush(Client& c) {
 }
 
 void ControlServer::broadcast(const nlohmann::json& event) {
-    const auto text = serialise(event);
+    broadcast(std::string_view(serialise(event)));
+}
+
+void ControlServer::broadcast(std::string_view line) {
     for (auto& c : clients_)
         if (c.subscribed && !c.closed) {
-            c.out += text;
+            c.out += line;
             flush(c);
         }
 }
 
 std::size_t ControlServer::clients() const {
     return clients_.size();
+}
+
+std::size_t ControlServer::subscribers() const {
+    return static_cast<std::size_t>(std::count_if(clients_.begin(), clients_.end(),
+                                                  [](const Client& c) { return c.subscribed; }));
 }
 
 }  // namespace lipsyncd::daemon

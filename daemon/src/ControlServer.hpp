@@ -27,7 +27,11 @@ class ControlServer {
     void addPollFds(std::vector<pollfd>& fds) const;
     void service(const Handler& handle);          // accept, read, answer, write: never blocks
     void broadcast(const nlohmann::json& event);  // to subscribers
+    // A line already serialised (the tick's frame events): copied into each subscriber's
+    // outgoing buffer, whose capacity stays once it has grown (no allocation per event).
+    void broadcast(std::string_view line);
     std::size_t clients() const;
+    std::size_t subscribers() const;
     // One request line's reply (subscribe sets `subscribed`); never throws.
     static nlohmann::json reply(const std::string& line, bool& subscribed, const Handler& handle);
     static std::string serialise(const nlohmann::json& reply);  // one line, always valid JSON

@@ -44,6 +44,7 @@ Daemon::Impl::Impl(std::filesystem::path file)
     : configFile(std::move(file)), start(monotonicSeconds()) {
     setup = std::make_unique<Setup>(DaemonConfig::load(configFile), nullptr, logWarning);
     queue.setCapacity(setup->config.maxQueue);
+    setupChanged();
     control = std::make_unique<ControlServer>(setup->config.socket, setup->config.socketMode,
                                               setup->config.maxClients, logInfo);
     sd_watchdog_enabled(0, &watchdogUsec);
@@ -69,8 +70,9 @@ void Daemon::Impl::tick() {
         }
     const auto& config = setup->config;
     // The mouth leads the sound by the puppet's lead time; the user's offset moves it later.
-    const auto clipFrame = player.tick(
-        *setup->audio, setup->puppet->leadSeconds - config.syncOffsetSeconds, config.outputRateHz);
+    const auto clipFrame =
+        player.tick(*setup->audio, setup->puppet->leadSeconds - config.syncOffsetSeconds,
+                    config.runtime.config.outputRate);
     if (live) {  // live input has the mouth while it is on
         const auto liveFrame = live->tick();
         liveFrame.empty() ? driver.tick(t) : driver.update(t, liveFrame);
@@ -86,7 +88,7 @@ void Daemon::Impl::tick() {
         ++clipsPlayed;
         if (queue.empty()) status("idle");
     }
-    if (control->clients() > 0 && t - lastEvent >= 0.04) {
+    if (control->subscribers() > 0 && t - lastEvent >= 0.04) {
         lastEvent = t;
         control->broadcast(frameEvent(t));
     }
@@ -99,7 +101,7 @@ void Daemon::Impl::tick() {
 void Daemon::Impl::reportFailures() {
     for (const auto& f : queue.takeFailures()) {
         logWarning("cannot play " + f);
-        control->broadcast({{"event", "failed"}, {"error", f}});
+        control->broadcast(json{{"event", "failed"}, {"error", f}});
     }
 }
 

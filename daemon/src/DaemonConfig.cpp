@@ -20,6 +20,24 @@ std::size_t count(const TomlTable& t, const std::string& key, std::size_t fallba
                "must be a whole number within " + std::to_string(lo) + " .. " + std::to_string(hi));
     return static_cast<std::size_t>(v);
 }
+// A shipped data file by name ("facefx" in FOLDER/facefx.EXT) or a path: it must exist.
+std::string dataName(const TomlTable& t, const std::string& key, const std::string& fallback,
+                     const std::string& folder, const std::string& extension) {
+    const auto name = t.optString(key).value_or(fallback);
+    if (name.empty()) return name;
+    std::string problem;
+    try {
+        const auto file =
+            folder.empty() ? findDataFile(name) : findNamedDataFile(name, folder, extension);
+        if (!std::filesystem::is_regular_file(file)) problem = file.string() + ": not a file";
+    } catch (const InputError& e) {
+        problem = e.what();
+    }
+    if (!problem.empty())
+        t.fail(key,
+               problem + (folder.empty() ? "" : " (a name in config/" + folder + " or a file)"));
+    return name;
+}
 }  // namespace
 
 DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
@@ -32,13 +50,23 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
     }
     if (const auto mouth = root.optTable("mouth")) {
         c.puppet = mouth->optString("puppet").value_or(c.puppet);
-        c.poses = mouth->optString("poses").value_or(c.poses);
-        c.curves = mouth->optString("curves").value_or(c.curves);
-        c.character = mouth->optString("character").value_or("");
-        c.runtime = mouth->optString("runtime").value_or(c.runtime);
-        if (c.runtime != "bigram" && c.runtime != "filter")
+        // The runtime, checked here so a wrong name stops start-up at its key and line.
+        auto& r = c.runtime;
+        r.poses = dataName(*mouth, "poses", r.poses, "poses", ".toml");
+        r.curves = dataName(*mouth, "curves", r.curves, "curves", ".json");
+        r.character = dataName(*mouth, "character", "", "", "");
+        r.phonemes = mouth->optString("phonemes").value_or(r.phonemes);
+        try {
+            PhonemeSet::named(r.phonemes);
+        } catch (const InputError& e) {
+            mouth->fail("phonemes",
+                        std::string("not a phoneme set (common, mandarin or a file): ") + e.what());
+        }
+        r.kind = mouth->optString("runtime").value_or(r.kind);
+        if (r.kind != "bigram" && r.kind != "filter")
             mouth->fail("runtime", "must be \"bigram\" or \"filter\"");
-        c.templates = mouth->optString("templates").value_or("");
+        r.loudness = mouth->optBool("loudness").value_or(r.loudness);
+        c.templates = dataName(*mouth, "templates", "", "templates", ".json");
         c.voice = mouth->optString("voice").value_or(c.voice);
         if (mouth->optNumber("lead"))
             mouth->fail("lead", "belongs to the puppet file now (lead = SECONDS: its servo lag)");
@@ -46,10 +74,10 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         c.hardware = mouth->optBool("hardware").value_or(true);
         c.record = mouth->optString("record").value_or("");
         c.terminal = mouth->optBool("terminal").value_or(false);
-        const double rate = mouth->optNumber("output_rate").value_or(100);
+        const double rate = mouth->optNumber("output_rate").value_or(r.config.outputRate);
         if (!(rate >= 10 && rate <= 1000))
             mouth->fail("output_rate", "must be within 10 .. 1000 Hz");
-        c.outputRateHz = rate;
+        r.config.outputRate = rate;
         mouth->finish();
     }
     if (const auto live = root.optTable("live")) {

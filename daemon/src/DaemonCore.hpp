@@ -8,6 +8,7 @@
 
 #include "ClipQueue.hpp"
 #include "ControlServer.hpp"
+#include "FrameEvent.hpp"
 #include "LiveMode.hpp"
 #include "Player.hpp"
 #include "PoseHold.hpp"
@@ -50,7 +51,9 @@ struct Daemon::Impl {
     nlohmann::json holdPose(const nlohmann::json& request);  // PoseRequest.cpp
 
     // Events.cpp
-    nlohmann::json frameEvent(double t) const;
+    FrameEventWriter frameWriter;
+    std::string_view frameEvent(double t);  // this tick's frame event line (no allocation)
+    void setupChanged();                    // a new setup: its pose and actuator names
     nlohmann::json statusReply() const;
 };
 

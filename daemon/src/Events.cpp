@@ -6,19 +6,18 @@ namespace lipsyncd::daemon {
 
 using nlohmann::json;
 
-json Daemon::Impl::frameEvent(double t) const {
-    json weights = json::object(), actuators = json::object();
-    const auto commands = setup->driver->last();
-    for (std::size_t i = 0; i < commands.size(); ++i)
-        actuators[setup->puppet->actuators[i].name] = commands[i].value;
-    if (const auto* clip = player.clip()) {
-        const auto frame = player.frame();
-        for (std::size_t p = 0; p < clip->weights.poses.size() && p < frame.size(); ++p)
-            weights[clip->weights.poses[p]] = frame[p];
-    }
-    json event = {{"event", "frame"}, {"time", t}, {"weights", weights}, {"actuators", actuators}};
-    if (player.clip()) event["position"] = player.clock().heard;
-    return event;
+// The weights and the actuator commands of this very tick, and the clock read in it.
+std::string_view Daemon::Impl::frameEvent(double t) {
+    const auto* clip = player.clip();
+    return frameWriter.format(t, clip ? player.frame() : std::span<const float>{},
+                              setup->driver->last(),
+                              clip ? std::optional(player.clock().heard) : std::nullopt);
+}
+
+void Daemon::Impl::setupChanged() {
+    std::vector<std::string> actuators;
+    for (const auto& a : setup->puppet->actuators) actuators.push_back(a.name);
+    frameWriter.setNames(setup->clips->poseNames(), actuators);
 }
 
 json Daemon::Impl::statusReply() const {
@@ -26,12 +25,15 @@ json Daemon::Impl::statusReply() const {
     const auto& config = setup->config;
     // End to end: a clip's sample handed to the device until it is heard (the mouth is driven
     // `lead` ahead of it, so the servo arrives with it); live, a sound at the microphone until
-    // the mouth has moved: the front end's bound, a tick, and the servo's lag.
+    // the mouth has moved: the front end's bound, a tick, and the servo's lag. Live sound is
+    // heard as it is made, so nothing can be sent ahead of it: the puppet's lead cannot be
+    // applied there, it adds to the latency instead ("lead_applied": false).
     const double lead = setup->puppet->leadSeconds;
     const double tickSeconds = 0.01;
     json latency = {
         {"audio_delay", player.clock().delay},
         {"lead", lead},
+        {"lead_applied", !live},
         {"sync_offset", config.syncOffsetSeconds},
         {"end_to_end", live ? live->frontEndLatency() + tickSeconds + lead : player.clock().delay}};
     return {{"ok", true},
@@ -43,7 +45,10 @@ json Daemon::Impl::statusReply() const {
             {"at_rest", setup->driver->atRest()},
             {"live", live.has_value()},
             {"live_started", live ? live->started() : -1.0},
-            {"latency", latency}};
+            {"latency", latency},
+            // What clips hold: the one playing, and the queue (one made ready ahead at most).
+            {"memory",
+             {{"playing_bytes", clip ? bytesOf(*clip) : 0}, {"queue_bytes", queue.bytesHeld()}}}};
 }
 
 }  // namespace lipsyncd::daemon

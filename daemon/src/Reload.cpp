@@ -36,9 +36,9 @@ Setup::Setup(DaemonConfig c, Setup* previous, const std::function<void(const std
 bool Setup::keepsDriverFor(const Setup& next) const {
     const auto& a = config;
     const auto& b = next.config;
-    return a.puppet == b.puppet && puppetText == next.puppetText && a.poses == b.poses &&
-           a.hardware == b.hardware && a.record == b.record && a.terminal == b.terminal &&
-           clips->poseNames() == next.clips->poseNames();
+    return a.puppet == b.puppet && puppetText == next.puppetText &&
+           a.runtime.poses == b.runtime.poses && a.hardware == b.hardware && a.record == b.record &&
+           a.terminal == b.terminal && clips->poseNames() == next.clips->poseNames();
 }
 
 void Setup::buildDriver(const std::function<void(const std::string&)>& warn, bool appendRecord) {
@@ -86,6 +86,7 @@ void Daemon::Impl::reload() {
         queue.setCapacity(fresh->config.maxQueue);
         control->setMaxClients(fresh->config.maxClients);
         setup = std::move(fresh);
+        setupChanged();
         status(std::string("reloaded; ") +
                (player.clip() ? "playing " + player.clip()->name : "idle"));
     } catch (const std::exception& e) {

@@ -33,7 +33,7 @@ inline nlohmann::json readDataDocument(const std::filesystem::path& file, const 
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number out of range
         throw InputError(source, 0, std::string("not valid JSON: ") + e.what());
     }
     if (member<std::string>(j, "format", "", source) != format)

@@ -30,19 +30,19 @@ LevelTrack measure(std::span<const Sample> samples, int sampleRate, double frame
     const auto half = static_cast<std::ptrdiff_t>(windowSeconds * sampleRate / 2);
     const auto n = static_cast<std::ptrdiff_t>(samples.size());
     const auto frames = static_cast<std::size_t>(std::floor(static_cast<double>(n) / hop)) + 1;
-    // Running sums of squares make each frame O(1) whatever the window.
-    std::vector<double> cumulative(samples.size() + 1, 0.0);
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-        const double x = sampleValue(samples[i]);
-        cumulative[i + 1] = cumulative[i] + x * x;
-    }
+    // Each frame sums its own window: no buffer the size of the audio (a 40 s `say` in the
+    // service would otherwise hold 7 MB of running sums), and the windows are short.
     track.db.reserve(frames);
     for (std::size_t f = 0; f < frames; ++f) {
         const auto centre = static_cast<std::ptrdiff_t>(std::llround(static_cast<double>(f) * hop));
         const auto lo = std::clamp<std::ptrdiff_t>(centre - half, 0, n);
         const auto hi = std::clamp<std::ptrdiff_t>(centre + half, 0, n);
-        const double energy = hi > lo ? (cumulative[hi] - cumulative[lo]) / (hi - lo) : 0.0;
-        track.db.push_back(toDb(energy));
+        double energy = 0;
+        for (auto i = lo; i < hi; ++i) {
+            const double x = sampleValue(samples[static_cast<std::size_t>(i)]);
+            energy += x * x;
+        }
+        track.db.push_back(toDb(hi > lo ? energy / static_cast<double>(hi - lo) : 0.0));
     }
     return track;
 }

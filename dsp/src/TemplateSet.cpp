@@ -149,6 +149,11 @@ TemplateSet TemplateSet::loadDefault() {
     return load(findDataFile("templates/default.json"));
 }
 
+TemplateSet TemplateSet::named(const std::string& nameOrPath) {
+    if (nameOrPath.empty()) return loadDefault();
+    return load(findNamedDataFile(nameOrPath, "templates", ".json"));
+}
+
 void TemplateSet::save(const std::filesystem::path& file) const {
     validate(file.string());
     json classesJson = json::array();

@@ -18,7 +18,7 @@ json readJson(const std::filesystem::path& file) {
     if (!in) throw InputError(file.string() + ": cannot open");
     try {
         return json::parse(in);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // bad syntax, or a number out of range (1e600)
         throw InputError(file.string() + ": not valid JSON (" + e.what() + ")");
     }
 }
@@ -28,9 +28,15 @@ json readJson(const std::filesystem::path& file) {
     throw InputError(file.string() + ": " + where + ": " + what);
 }
 
+// The "format" string, "" when absent or not a string (json::value would throw on a number).
+std::string formatOf(const json& j) {
+    return j.is_object() && j.contains("format") && j["format"].is_string()
+               ? j["format"].get<std::string>()
+               : std::string();
+}
+
 void checkHeader(const json& j, const std::filesystem::path& file, const char* format) {
-    if (!j.is_object() || j.value("format", "") != format)
-        fail(file, "format", std::string("expected \"") + format + "\"");
+    if (formatOf(j) != format) fail(file, "format", std::string("expected \"") + format + "\"");
     if (!j.contains("version") || !j["version"].is_number_integer() || j["version"] != kVersion)
         fail(file, "version", "expected " + std::to_string(kVersion));
     if (!j.contains("name") || !j["name"].is_string()) fail(file, "name", "missing (a string)");
@@ -129,7 +135,11 @@ void BigramCurveSet::setCurve(std::size_t first, std::size_t second, std::size_t
 
 BigramCurveSet BigramCurveSet::load(const std::filesystem::path& file, const PoseSet& poses,
                                     const PhonemeSet& phonemes) {
-    return loadSet(file, poses, phonemes, true);
+    try {
+        return loadSet(file, poses, phonemes, true);
+    } catch (const json::exception& e) {  // a value of a type no check above expected
+        throw InputError(file.string() + ": unexpected JSON (" + e.what() + ")");
+    }
 }
 
 // A character's base may cover fewer classes than `phonemes` (a language adding one, as paper
@@ -137,7 +147,7 @@ BigramCurveSet BigramCurveSet::load(const std::filesystem::path& file, const Pos
 BigramCurveSet BigramCurveSet::loadSet(const std::filesystem::path& file, const PoseSet& poses,
                                        const PhonemeSet& phonemes, bool requireEveryPair) {
     const auto j = readJson(file);
-    if (j.is_object() && j.value("format", "") == kCharacterFormat) {
+    if (formatOf(j) == kCharacterFormat) {
         checkHeader(j, file, kCharacterFormat);
         if (!j.contains("base") || !j["base"].is_string())
             fail(file, "base", "missing (the curve set it starts from)");
@@ -180,7 +190,7 @@ void BigramCurveSet::applyBigramsJson(std::string_view bigramsJson, const std::s
     json j;
     try {
         j = json::parse(bigramsJson);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // bad syntax, or a number out of range
         throw InputError(source + ": not valid JSON (" + e.what() + ")");
     }
     readBigrams(j, source, poses, phonemes, *this);

@@ -42,6 +42,18 @@ TEST(HostileClient, InvalidUtf8GetsAValidJsonReply) {
     EXPECT_EQ(d.stop(), 0);
 }
 
+TEST(HostileClient, ANumberBeyondADoubleGetsAnErrorNotAnExit) {
+    // nlohmann::json reports 1e600 as out_of_range, not parse_error (found by fuzzing
+    // curve_json; the control socket had the same catch).
+    DaemonProcess d;
+    d.start();
+    Client c(d.dir / "control.sock");
+    ASSERT_TRUE(c.connected());
+    expectRefusedAndAlive(d, c, R"({"cmd":"status","n":1e600})");
+    expectRefusedAndAlive(d, c, R"({"cmd":"say","text":"hi","voice":-1e999})");
+    EXPECT_EQ(d.stop(), 0);
+}
+
 TEST(HostileClient, TheTailOfAnOverlongLineNeverRuns) {
     DaemonProcess d;
     d.start();

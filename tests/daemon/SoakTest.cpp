@@ -132,9 +132,17 @@ TEST(Soak, AFullQueueOfTheLongestClipsKeepsMemorySmall) {
     const auto s = c.request({{"cmd", "status"}});
     EXPECT_FALSE(s["playing"].is_null()) << s;
     std::cout << "RSS with 8 queued 30 s clips at 48 kHz: " << peak << " KiB at most\n";
-    // 8 clips held decoded would be 8 x 5.8 MB over the ~14 MB idle daemon. Prepared one
-    // ahead it stays near 18 MB on an idle machine; under CPU contention up to ~31 MB was seen
-    // (not understood yet), so the bound here is the one that tells the two designs apart.
+    // What the clips hold is counted exactly: the one playing and the one ready ahead, never
+    // the eight (2.9 MB each at 48 kHz, and the weights).
+    const std::size_t clip = 30 * 48000 * 2 * 101 / 100 + 3002 * (10 * 4 + 8);
+    const auto& m = s["memory"];
+    EXPECT_LE(m["playing_bytes"].get<std::size_t>() + m["queue_bytes"].get<std::size_t>(),
+              2 * clip + 8 * 4096)
+        << s;
+    // RSS, loosely: 8 clips held decoded would be 8 x 2.9 MB over the ~15 MB idle daemon.
+    // (The 29-31 MB once seen under contention were transients of the worker: a second float
+    // copy of each file for its levels and a per-sample buffer in the level meter, both gone;
+    // scripts/measure-daemon.sh memory measures the peak.)
     EXPECT_LT(peak, 36 * 1024);
     EXPECT_EQ(d.stop(), 0);
 }

@@ -59,5 +59,22 @@ TEST(EspeakSynthesizer, UnknownVoiceIsAnInputErrorNamingIt) {
     }
 }
 
+TEST(EspeakSynthesizer, SpeechStopsAtTheRequestsLimitAndSaysSo) {
+    const std::string text = "One two three four five six seven eight nine ten eleven twelve.";
+    auto& synth = synthesizer();
+    const auto whole = synth.synthesize({text, "en-us", 0, -1});
+    ASSERT_GT(whole.samples.size(), static_cast<std::size_t>(2 * synth.sampleRate()));
+    EXPECT_FALSE(whole.truncated);
+    const auto cut = synth.synthesize({text, "en-us", 0, -1, 1.0});
+    EXPECT_TRUE(cut.truncated);
+    EXPECT_LE(cut.samples.size(), static_cast<std::size_t>(synth.sampleRate()) + 1);
+    EXPECT_LE(cut.samples.capacity(), static_cast<std::size_t>(synth.sampleRate()) + 1)
+        << "held more than the limit";
+    // The next request starts afresh: nothing of the cut text is left in espeak-ng.
+    const auto next = synth.synthesize({"Hello.", "en-us", 0, -1});
+    EXPECT_FALSE(next.truncated);
+    EXPECT_LT(next.samples.size(), whole.samples.size() / 3);
+}
+
 }  // namespace
 }  // namespace lipsyncd

@@ -31,7 +31,8 @@ std::optional<std::string> readWords(const std::filesystem::path& file,
 PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                 const std::optional<std::string>& text, const std::string& voice,
                                 const dsp::TemplateSet& templates, const dsp::DecodeOptions& decode,
-                                const std::function<void(const std::string&)>& log) {
+                                const std::function<void(const std::string&)>& log,
+                                LevelTrack* levels) {
     std::optional<std::string> words = text;
     std::string source = "the request";
     if (!words)
@@ -45,13 +46,16 @@ PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem:
             log(audio.string() + ": words from " + source + " aligned" +
                 (r.fellBack ? " (fell back to audio-only analysis)" : ""));
             for (const auto& w : r.warnings) log(audio.string() + ": " + w);
+            if (levels) *levels = r.levels;
             return r.schedule;
         } catch (const InputError& e) {
             log(audio.string() + ": words from " + source + " not used: " + e.what() +
                 "; audio-only analysis");
         }
     }
-    return dsp::analyzeFile(audio, templates, PhonemeSet::common(), {}, decode).schedule;
+    auto r = dsp::analyzeFile(audio, templates, PhonemeSet::common(), {}, decode);
+    if (levels) *levels = std::move(r.levels);
+    return std::move(r.schedule);
 }
 
 }  // namespace lipsyncd

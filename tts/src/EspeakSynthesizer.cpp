@@ -13,6 +13,8 @@ std::atomic<bool> gInstanceAlive{false};
 // Collects one synthesis: samples, and a phoneme event stream turned into segments.
 struct Collector {
     std::vector<std::int16_t>* samples;
+    std::size_t maxSamples = 0;  // 0: no limit
+    bool truncated = false;
     std::vector<std::pair<double, std::string>> events;  // (time s, mnemonic)
     // Word starts: (character position in the text, 1-based; length in characters; the index
     // of the first phoneme event after it).
@@ -40,8 +42,16 @@ int onSynth(short* wav, int count, espeak_EVENT* events) {
             collector->words.push_back({e->text_position, e->length, collector->events.size()});
         if (e->type == espeakEVENT_LIST_TERMINATED) break;
     }
-    if (collector && wav && count > 0 && collector->samples)
-        collector->samples->insert(collector->samples->end(), wav, wav + count);
+    if (collector && wav && count > 0 && collector->samples) {
+        auto& out = *collector->samples;
+        auto n = static_cast<std::size_t>(count);
+        if (collector->maxSamples && out.size() + n > collector->maxSamples) {
+            n = collector->maxSamples - out.size();
+            collector->truncated = true;
+        }
+        out.insert(out.end(), wav, wav + n);
+        if (collector->truncated) return 1;  // stop synthesis: the limit is reached
+    }
     return 0;  // continue synthesis
 }
 
@@ -135,7 +145,11 @@ SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request)
 
     SynthesizedSpeech out;
     out.sampleRate = sampleRate_;
-    Collector collector{&out.samples, {}, {}};
+    Collector collector{&out.samples};
+    if (request.maxSeconds > 0) {
+        collector.maxSamples = static_cast<std::size_t>(request.maxSeconds * sampleRate_) + 1;
+        out.samples.reserve(collector.maxSamples);  // held at most: no growth, no copies
+    }
     const auto rc = espeak_Synth(request.text.c_str(), request.text.size() + 1, 0, POS_CHARACTER, 0,
                                  espeakCHARS_UTF8, nullptr, &collector);
     if (rc != EE_OK) throw std::runtime_error("espeak-ng: synthesis failed");
@@ -149,6 +163,7 @@ SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request)
         if (end > start) out.phonemes.push_back({start, end, ev[i].second, 1.0f});
     }
     out.words = spokenWords(request.text, collector, total);
+    out.truncated = collector.truncated;
     return out;
 }
 

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <lipsyncd/core.hpp>
+#include <lipsyncd/lipsync.hpp>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
@@ -42,11 +43,10 @@ struct DaemonConfig {
     std::string device = "default";  // an ALSA device, "null" (no sound), or "file:PATH.wav"
     // [mouth]
     std::string puppet = "terminal";
-    std::string poses = "facefx";
-    std::string curves = "english";
-    std::string character;
-    std::string runtime = "bigram";  // bigram | filter
-    std::string templates;           // empty: the shipped default
+    // poses, curves, character, phonemes, runtime, output_rate, loudness: the runtime as
+    // `lipsync animate` names it (lipsync::Runtime builds both).
+    lipsync::RuntimeSpec runtime;
+    std::string templates;  // empty: the shipped default (dsp::TemplateSet::named)
     std::string voice = "en-us";
     // (The lead that makes up for servo lag belongs to the puppet file: Puppet::leadSeconds.)
     double syncOffsetSeconds = 0;  // the user's correction, + moves the mouth later
@@ -60,7 +60,6 @@ struct DaemonConfig {
     std::filesystem::path socket = "/run/lipsyncd/control.sock";
     unsigned socketMode = 0660;
     std::size_t maxClients = 16;  // more get {"ok": false, "error": "too many clients"}
-    double outputRateHz = 100;
     // [limits]: what one request may cost (memory, the worker's time).
     double maxClipSeconds = 30;
     std::size_t maxTextBytes = 600;
@@ -163,8 +162,10 @@ class ClipMaker {
                   const std::optional<std::string>& knownText = std::nullopt,
                   const std::function<void(const std::string&)>& log = {}) const;
     // espeak-ng allows one synthesiser per process, for the process's life: the daemon owns it.
-    Clip fromText(EspeakSynthesizer& synth, const std::string& text,
-                  const std::string& voice) const;
+    // Speech longer than `maxSeconds` (0: no limit) is an InputError, found without ever
+    // holding more than that much of it.
+    Clip fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice,
+                  double maxSeconds = 0) const;
     const std::vector<std::string>& poseNames() const;
     // The live path: front end and runtime in their streaming forms (causal: least delay).
     class Live;

@@ -240,6 +240,9 @@ struct TemplateSet {
 
     static TemplateSet load(const std::filesystem::path& file);  // validates; InputError
     static TemplateSet loadDefault();                            // config/templates/default.json
+    // "" (the default), a name in config/templates ("default") or a file: what `--templates`
+    // and lipsyncd's `templates` key both take.
+    static TemplateSet named(const std::string& nameOrPath);
     void save(const std::filesystem::path& file) const;
     void validate(const std::string& source) const;
 };

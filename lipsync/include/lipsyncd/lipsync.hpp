@@ -12,6 +12,9 @@
 //                    smoothing → constraints → speed limits, each step switchable.
 //   StreamingRuntime the same, fed segment by segment, with a fixed delay (or causal).
 //   animateFilter()  the viseme-space filter of paper 001, section 5: a second, simpler runtime.
+//   RuntimeSpec      the runtime as a user names it (pose set, curves or character, phoneme
+//                    set, kind, steps); `lipsync`'s options and lipsyncd's [mouth] fill it.
+//   Runtime          a RuntimeSpec loaded once: the one place both build the runtime from.
 #pragma once
 
 #include <cstddef>
@@ -289,6 +292,48 @@ class StreamingRuntime {
     double origin_ = 0;        // time of frame 0: the first segment's start
     std::size_t emitted_ = 0;  // frames already out
     std::vector<float> last_;  // the last frame out
+};
+
+// ---------------------------------------------------------------------------------------------
+// The runtime by name: what `lipsync animate/analyze/align/say/eval` and lipsyncd's [mouth]
+// table both say, built in one place so the two never drift apart.
+
+struct RuntimeSpec {
+    std::string poses = "facefx";     // config/poses/NAME.toml or a file
+    std::string curves = "english";   // config/curves/NAME.json or a file
+    std::string character;            // a character file (a base set, some bigrams replaced)
+    std::string phonemes = "common";  // config/phonemes/NAME.toml or a file: the schedule's set
+    std::string kind = "bigram";      // bigram (paper 000) | filter (paper 001, section 5)
+    RuntimeConfig config;
+    bool loudness = true;  // louder speech opens wider (the poses' loudness_gain)
+};
+
+class Runtime {
+  public:
+    // Loads the pose set, the phoneme set and the curves (or the character). InputError
+    // naming the spec's field, the value and the file ("curves 'x': FILE:LINE: ...").
+    explicit Runtime(RuntimeSpec spec);
+    // Streaming runtimes point into it: it stays where it was built.
+    Runtime(const Runtime&) = delete;
+    Runtime& operator=(const Runtime&) = delete;
+
+    const RuntimeSpec& spec() const { return spec_; }
+    const PoseSet& poses() const { return poses_; }
+    const PhonemeSet& phonemes() const { return *phonemes_; }
+    const BigramCurveSet& curves() const { return curves_; }
+
+    // Offline, the spec's kind; with `levels` (the speech's frame levels) and spec.loudness,
+    // louder speech opens wider within what each phoneme allows.
+    PoseTrack animate(std::span<const PhonemeSegment> schedule,
+                      const LevelTrack* levels = nullptr) const;
+    // Segment by segment (the bigram runtime) with `delaySeconds` of look-ahead, 0: causal.
+    StreamingRuntime streaming(double delaySeconds) const;
+
+  private:
+    RuntimeSpec spec_;
+    const PhonemeSet* phonemes_;
+    PoseSet poses_;
+    BigramCurveSet curves_;
 };
 
 // ---------------------------------------------------------------------------------------------

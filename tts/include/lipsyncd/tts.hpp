@@ -20,6 +20,9 @@ struct SynthesisRequest {
     std::string voice = "en-us";  // any espeak-ng voice, variants with '+', e.g. "en-us+f2"
     int wordsPerMinute = 0;       // 0: the voice's default (175)
     int pitch = -1;               // 0..100, -1: default
+    // 0: no limit. Otherwise speech stops there (`truncated` says so), and no more than this
+    // is ever held: the service's max_clip_seconds bounds its memory and the worker's time.
+    double maxSeconds = 0;
 };
 
 // One word of the text as espeak-ng read it: a number may become several spoken words, all
@@ -37,6 +40,7 @@ struct SynthesizedSpeech {
     PhonemeSchedule phonemes;
     // The same phonemes by written word (espeak-ng's word events).
     std::vector<SpokenWord> words;
+    bool truncated = false;  // the text was longer than the request's maxSeconds
 };
 
 // espeak-ng holds global state, so one synthesiser exists at a time (a second throws).
@@ -115,12 +119,14 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
 // words of a `FILE.txt` beside `FILE.wav` when there is one, else the audio-only analysis. Text
 // that cannot be aligned (empty, unreadable) falls back to the audio-only analysis. `log` gets
 // one line saying which was used, and the alignment's warnings. For the service's clip
-// preparation.
+// preparation; `levels`, when given, gets the analysis's frame levels (the loudness shaping's
+// input, so the caller need not read the audio a second time).
 PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                 const std::optional<std::string>& text, const std::string& voice,
                                 const dsp::TemplateSet& templates,
                                 const dsp::DecodeOptions& decode,
-                                const std::function<void(const std::string&)>& log);
+                                const std::function<void(const std::string&)>& log,
+                                LevelTrack* levels = nullptr);
 
 // The words file beside an audio file (FILE.wav → FILE.txt), if there is one.
 std::optional<std::filesystem::path> wordsBeside(const std::filesystem::path& audio);
