@@ -193,7 +193,11 @@ void BigramCurveSet::applyBigramsJson(std::string_view bigramsJson, const std::s
     } catch (const json::exception& e) {  // bad syntax, or a number out of range
         throw InputError(source + ": not valid JSON (" + e.what() + ")");
     }
-    readBigrams(j, source, poses, phonemes, *this);
+    try {
+        readBigrams(j, source, poses, phonemes, *this);
+    } catch (const json::exception& e) {  // a value of a type no check expected, as in load()
+        throw InputError(source + ": unexpected JSON (" + e.what() + ")");
+    }
 }
 
 BigramCurveSet BigramCurveSet::named(const std::string& nameOrPath, const PoseSet& poses,

@@ -128,6 +128,26 @@ TEST(CurveFiles, ErrorsNameTheBigramAndPose) {
     EXPECT_NE(errorLoading("{").find("not valid JSON"), std::string::npos);
 }
 
+// The editor hands a client's bigram JSON straight to applyBigramsJson: every malformed shape is
+// an InputError naming the source (the editor applies it to a scratch copy, so nothing is kept).
+TEST(CurveFiles, MalformedBigramsFromAClientAreRefusedByName) {
+    const auto poses = lipsync::PoseSet::named("facefx");
+    const auto& phonemes = PhonemeSet::common();
+    auto set = lipsync::BigramCurveSet::named("english", poses, phonemes);
+    for (const std::string bad :
+         {R"({"f-ah": 3})", R"({"f-ah": {"open": "x"}})", R"({"f-ah": {"open": [["a", 1]]}})",
+          R"({"f-ah": {"open": [[0, {}], [1, 0]]}})", R"({"f-ah": {"open": [[0], [1, 0]]}})",
+          R"({"f-ah": {"open": [0, 1]}})", R"([1, 2])", R"({"f-ah": {"open": [[0, 1e600]]}})"}) {
+        try {
+            set.applyBigramsJson(bad, "PUT /api/bigrams/f/ah", poses, phonemes);
+            ADD_FAILURE() << "accepted " << bad;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("PUT /api/bigrams/f/ah"), std::string::npos)
+                << e.what();
+        }
+    }
+}
+
 TEST(CurveFiles, ACharacterReplacesSingleBigramsOnly) {
     const auto poses = lipsync::PoseSet::named("facefx");
     const auto base = lipsync::BigramCurveSet::named("english", poses);
