@@ -107,8 +107,8 @@ std::vector<SpokenWord> spokenWords(const std::string& text, const Collector& c,
         const auto last = w + 1 < c.words.size() ? c.words[w + 1].firstEvent : c.events.size();
         for (std::size_t i = mark.firstEvent; i < last; ++i) {
             const double start = std::min(c.events[i].first, total);
-            const double end = i + 1 < c.events.size() ? std::min(c.events[i + 1].first, total)
-                                                       : total;
+            const double end =
+                i + 1 < c.events.size() ? std::min(c.events[i + 1].first, total) : total;
             if (end > start) word.phonemes.push_back({start, end, c.events[i].second, 1.0f});
         }
         words.push_back(std::move(word));

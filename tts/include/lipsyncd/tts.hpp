@@ -3,11 +3,10 @@
 // producing and when.
 #pragma once
 
-#include <lipsyncd/core.hpp>
-#include <lipsyncd/dsp.hpp>
-
 #include <cstdint>
 #include <functional>
+#include <lipsyncd/core.hpp>
+#include <lipsyncd/dsp.hpp>
 #include <map>
 #include <optional>
 #include <string>
@@ -28,8 +27,8 @@ struct SynthesisRequest {
 // One word of the text as espeak-ng read it: a number may become several spoken words, all
 // under the one written word.
 struct SpokenWord {
-    std::string text;           // as written in the request
-    PhonemeSchedule phonemes;   // its phonemes in espeak-ng's mnemonics, with its timings
+    std::string text;          // as written in the request
+    PhonemeSchedule phonemes;  // its phonemes in espeak-ng's mnemonics, with its timings
 };
 
 struct SynthesizedSpeech {
@@ -45,7 +44,7 @@ struct SynthesizedSpeech {
 
 // espeak-ng holds global state, so one synthesiser exists at a time (a second throws).
 class EspeakSynthesizer {
-public:
+  public:
     // dataPath: espeak-ng-data folder, empty for the system default.
     explicit EspeakSynthesizer(const std::string& dataPath = "");
     ~EspeakSynthesizer();
@@ -56,7 +55,7 @@ public:
     SynthesizedSpeech synthesize(const SynthesisRequest& request);
     int sampleRate() const { return sampleRate_; }
 
-private:
+  private:
     int sampleRate_ = 0;
 };
 
@@ -123,8 +122,7 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
 // input, so the caller need not read the audio a second time).
 PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                 const std::optional<std::string>& text, const std::string& voice,
-                                const dsp::TemplateSet& templates,
-                                const dsp::DecodeOptions& decode,
+                                const dsp::TemplateSet& templates, const dsp::DecodeOptions& decode,
                                 const std::function<void(const std::string&)>& log,
                                 LevelTrack* levels = nullptr);
 
