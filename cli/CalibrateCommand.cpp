@@ -1,10 +1,14 @@
-// lipsync calibrate: a speaker's own templates from a few sustained sounds (aa.wav, ih.wav,
-// bmp.wav, ...), on top of a base set for the classes not recorded.
+// lipsync calibrate: a speaker's own templates, on top of a base set for the classes not heard,
+// from a few sustained sounds (aa.wav, ih.wav, bmp.wav, ...) or from read speech with its words
+// (NAME.wav + NAME.txt: the known-script aligner labels the frames).
 #include <algorithm>
 #include <iostream>
 #include <lipsyncd/dsp.hpp>
+#include <lipsyncd/tts.hpp>
+#include <optional>
 
 #include "Commands.hpp"
+#include "Corpus.hpp"
 
 namespace lipsyncd::cli {
 
@@ -13,6 +17,7 @@ struct CalibrateOptions {
     std::string folder;
     std::string output;
     std::string base;
+    std::string voice = "en-us";
     int clusters = 2;
 };
 
@@ -20,6 +25,41 @@ struct CalibrateOptions {
 std::string classOfFile(const std::filesystem::path& file) {
     const auto stem = file.stem().string();
     return stem.substr(0, stem.find_first_of("-_."));
+}
+
+bool isAudio(const std::filesystem::path& file) {
+    const auto ext = file.extension().string();
+    return ext == ".wav" || ext == ".flac" || ext == ".ogg";
+}
+
+// Read speech: every recording with its words beside it (NAME.txt) is aligned on them, and its
+// frames train the classes the alignment places, as `lipsync train` does with reference labels.
+// A file with a word the aligner could not place is left out: its schedule there would be the
+// front end's own guess, and calibrating on that teaches the templates their own mistakes.
+std::vector<std::string> addReadSpeech(const CalibrateOptions& o, const dsp::TemplateSet& base,
+                                       dsp::TemplateTrainer& trainer,
+                                       const dsp::AnalysisConfig& analysis) {
+    std::optional<EspeakSynthesizer> synth;  // started only when there are words to read
+    std::vector<std::string> heard;
+    for (const auto& entry : std::filesystem::directory_iterator(o.folder)) {
+        if (!isAudio(entry.path())) continue;
+        const auto words = wordsBeside(entry.path());
+        if (!words) continue;
+        if (!synth) synth.emplace();
+        const auto aligned = alignText(*synth, entry.path(), readTextFile(*words), o.voice, base);
+        if (aligned.fellBack || !aligned.warnings.empty()) {
+            std::cerr << "lipsync calibrate: skipped " << entry.path().string() << ": "
+                      << (aligned.warnings.empty() ? "not aligned" : aligned.warnings.front())
+                      << '\n';
+            continue;
+        }
+        trainer.addUtterance(dsp::analyzeFrames(entry.path(), analysis), aligned.schedule);
+        for (const auto& seg : aligned.schedule)
+            if (seg.phoneme != "sil" &&
+                std::find(heard.begin(), heard.end(), seg.phoneme) == heard.end())
+                heard.push_back(seg.phoneme);
+    }
+    return heard;
 }
 
 void runCalibrate(const CalibrateOptions& o) {
@@ -31,11 +71,10 @@ void runCalibrate(const CalibrateOptions& o) {
     training.clustersPerClass = o.clusters;
     training.minFramesPerCluster = 10;  // a second of held sound is plenty for one speaker
     dsp::TemplateTrainer trainer(training, set);
-    std::vector<std::string> recorded;
     if (!std::filesystem::is_directory(o.folder)) throw InputError(o.folder + ": not a folder");
+    std::vector<std::string> recorded = addReadSpeech(o, base, trainer, training.analysis);
     for (const auto& entry : std::filesystem::directory_iterator(o.folder)) {
-        const auto ext = entry.path().extension().string();
-        if (ext != ".wav" && ext != ".flac" && ext != ".ogg") continue;
+        if (!isAudio(entry.path()) || wordsBeside(entry.path())) continue;
         const auto cls = classOfFile(entry.path());
         if (!set.find(cls)) {
             std::cerr
@@ -48,7 +87,9 @@ void runCalibrate(const CalibrateOptions& o) {
             recorded.push_back(cls);
     }
     if (recorded.empty())
-        throw InputError(o.folder + ": no recordings named after a phoneme class");
+        throw InputError(o.folder +
+                         ": no recordings named after a phoneme class, and none with its words "
+                         "beside it (NAME.wav + NAME.txt)");
     const auto own = trainer.build("calibration");
     for (const auto& cls : own.classes) {
         auto it = std::find_if(base.classes.begin(), base.classes.end(),
@@ -76,11 +117,14 @@ void addCalibrateCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "calibrate",
         "Build a speaker's templates from recordings of sustained sounds named after their class "
-        "(aa.wav, ih.wav, w.wav, bmp.wav, ...)");
+        "(aa.wav, ih.wav, w.wav, bmp.wav, ...) or of read speech with its words beside each "
+        "(NAME.wav + NAME.txt, aligned on them; half a minute is enough)");
     cmd->add_option("folder", o->folder, "Folder of recordings")->required();
     cmd->add_option("-o,--output", o->output, "Template file to write (JSON)")->required();
     cmd->add_option("--base", o->base,
                     "Templates for the classes not recorded (default: shipped set)");
+    cmd->add_option("--voice", o->voice, "espeak-ng voice that reads the words of read speech")
+        ->capture_default_str();
     cmd->add_option("--clusters", o->clusters, "Cluster means per recorded class")
         ->check(CLI::Range(1, 8))
         ->capture_default_str();

@@ -163,5 +163,41 @@ TEST(LipsyncCli, CalibrateBuildsLoadableTemplatesAndNamesStrayFiles) {
     EXPECT_EQ(set.classes.size(), PhonemeSet::common().size());
 }
 
+// Read speech with its words (NAME.wav + NAME.txt): the classes the aligner places get the
+// speaker's own templates, the rest keep the base set's; a recording whose words do not fit is
+// named and left out.
+TEST(LipsyncCli, CalibrateFromReadSpeechReplacesTheClassesItHeard) {
+    const auto dir = scratchDir("cli_calibrate_read");
+    const std::pair<const char*, const char*> lines[] = {
+        {"s1", "Hello puppet, open wide and sing to me."},
+        {"s2", "Bob bought a big bag of beans by the bay."},
+        {"s3", "Why do you sit so still when the show is on?"}};
+    for (const auto& [name, text] : lines) {
+        ASSERT_EQ(runLipsync({"say", text, "--wav", (dir / (std::string(name) + ".wav")).string()})
+                      .exitCode,
+                  0);
+        std::ofstream(dir / (std::string(name) + ".txt")) << text << '\n';
+    }
+    // Far more words than its audio holds: the aligner cannot place them all.
+    fs::copy_file(dir / "s1.wav", dir / "s4.wav", fs::copy_options::overwrite_existing);
+    std::ofstream(dir / "s4.txt") << "Twenty seven thousand and forty two unexpected "
+                                     "mathematicians politely disagreed about everything.\n";
+    const auto out = dir.parent_path() / "calibrated-read.json";
+    const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("skipped " + (dir / "s4.wav").string()), std::string::npos) << r.err;
+    const auto own = dsp::TemplateSet::load(out);
+    const auto base = dsp::TemplateSet::loadDefault();
+    ASSERT_EQ(own.classes.size(), base.classes.size());
+    auto spectraOf = [](const dsp::TemplateSet& set, const std::string& phoneme) {
+        for (const auto& c : set.classes)
+            if (c.phoneme == phoneme) return c.spectra;
+        return std::vector<std::vector<float>>{};
+    };
+    EXPECT_NE(spectraOf(own, "bmp"), spectraOf(base, "bmp")) << "b, m, p were heard: replaced";
+    EXPECT_NE(spectraOf(own, "ih"), spectraOf(base, "ih"));
+    EXPECT_EQ(spectraOf(own, "oy"), spectraOf(base, "oy")) << "no oy in these lines: kept";
+}
+
 }  // namespace
 }  // namespace lipsyncd::test
