@@ -2,18 +2,18 @@
 
 #include <cstring>
 
+#include "VectorLanes.hpp"
+
 namespace lipsyncd::dsp {
 
 namespace {
-using Lanes = float __attribute__((vector_size(8 * sizeof(float))));
-using Indices = int __attribute__((vector_size(8 * sizeof(int))));
+using Lanes = FloatLanes;
+using Indices = IntLanes;
 }  // namespace
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void bestEntries(const float* exitScore, const float* transition, std::size_t classes,
-                 std::size_t stride, float unreachable, float* enter, int* entryFrom) {
+LIPSYNCD_VECTOR_CLONES void bestEntries(const float* exitScore, const float* transition,
+                                        std::size_t classes, std::size_t stride, float unreachable,
+                                        float* enter, int* entryFrom) {
     for (std::size_t to = 0; to < stride; to += 8) {
         Lanes best = unreachable - Lanes{};
         Indices from = Indices{} - 1;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "VectorLanes.hpp"
+
 namespace lipsyncd::dsp::kernels {
 
 namespace {
@@ -12,18 +14,8 @@ namespace {
 constexpr float kClipLevel = 0.999f;
 constexpr float kClippedShare = 0.01f;
 
-// Eight lanes (GCC vector extension: AVX on x86-64, NEON on ARM).
-using Lanes8 = float __attribute__((vector_size(8 * sizeof(float))));
-using Counts8 = int __attribute__((vector_size(8 * sizeof(int))));
-
-// On x86-64 the vector loops are also built for AVX2 and picked at load time (one register for
-// eight lanes; the baseline splits them); other targets (the ARM boards puppets run on) get
-// their own default vectorisation.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define LIPSYNCD_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define LIPSYNCD_VECTOR_CLONES
-#endif
+using Lanes8 = FloatLanes;
+using Counts8 = IntLanes;
 }  // namespace
 
 // Eight partial sums (sample i into sum i mod 8), one vector of eight lanes.

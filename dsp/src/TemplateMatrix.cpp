@@ -5,6 +5,8 @@
 #include <cstring>
 #include <limits>
 
+#include "VectorLanes.hpp"
+
 namespace lipsyncd::dsp {
 
 TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& set)
@@ -29,16 +31,15 @@ TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& s
 }
 
 namespace {
-// Eight templates at once, one per lane (GCC vector extension: AVX on x86-64, NEON on ARM).
-using Lanes = float __attribute__((vector_size(TemplateMatrix::kLanes * sizeof(float))));
+// Eight templates at once, one per lane.
+using Lanes = FloatLanes;
+static_assert(TemplateMatrix::kLanes == kVectorLanes, "a block is one vector of lanes");
 
 // Squared distances from x to the eight templates of one block. Feature f goes into partial
 // sum f mod 8, as in a row loop of eight partial sums.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void nearestPerClass(const float* x, std::size_t features, const float* blocks,
-                     const int* blockClass, std::size_t blockCount, float* out) {
+LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features,
+                                            const float* blocks, const int* blockClass,
+                                            std::size_t blockCount, float* out) {
     const std::size_t stride = features * TemplateMatrix::kLanes;
     const std::size_t whole = features / 8 * 8;
     for (std::size_t block = 0; block < blockCount;) {
