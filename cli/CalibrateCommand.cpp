@@ -27,6 +27,11 @@ std::string classOfFile(const std::filesystem::path& file) {
     return stem.substr(0, stem.find_first_of("-_."));
 }
 
+// The classes recorded, each once, in the order first heard.
+void addOnce(std::vector<std::string>& classes, const std::string& cls) {
+    if (std::find(classes.begin(), classes.end(), cls) == classes.end()) classes.push_back(cls);
+}
+
 bool isAudio(const std::filesystem::path& file) {
     const auto ext = file.extension().string();
     return ext == ".wav" || ext == ".flac" || ext == ".ogg";
@@ -36,11 +41,10 @@ bool isAudio(const std::filesystem::path& file) {
 // frames train the classes the alignment places, as `lipsync train` does with reference labels.
 // A file with a word the aligner could not place is left out: its schedule there would be the
 // front end's own guess, and calibrating on that teaches the templates their own mistakes.
-std::vector<std::string> addReadSpeech(const CalibrateOptions& o, const dsp::TemplateSet& base,
-                                       dsp::TemplateTrainer& trainer,
-                                       const dsp::AnalysisConfig& analysis) {
+void addReadSpeech(const CalibrateOptions& o, const dsp::TemplateSet& base,
+                   dsp::TemplateTrainer& trainer, const dsp::AnalysisConfig& analysis,
+                   std::vector<std::string>& recorded) {
     std::optional<EspeakSynthesizer> synth;  // started only when there are words to read
-    std::vector<std::string> heard;
     for (const auto& entry : std::filesystem::directory_iterator(o.folder)) {
         if (!isAudio(entry.path())) continue;
         const auto words = wordsBeside(entry.path());
@@ -55,11 +59,8 @@ std::vector<std::string> addReadSpeech(const CalibrateOptions& o, const dsp::Tem
         }
         trainer.addUtterance(dsp::analyzeFrames(entry.path(), analysis), aligned.schedule);
         for (const auto& seg : aligned.schedule)
-            if (seg.phoneme != "sil" &&
-                std::find(heard.begin(), heard.end(), seg.phoneme) == heard.end())
-                heard.push_back(seg.phoneme);
+            if (seg.phoneme != "sil") addOnce(recorded, seg.phoneme);
     }
-    return heard;
 }
 
 void runCalibrate(const CalibrateOptions& o) {
@@ -72,7 +73,8 @@ void runCalibrate(const CalibrateOptions& o) {
     training.minFramesPerCluster = 10;  // a second of held sound is plenty for one speaker
     dsp::TemplateTrainer trainer(training, set);
     if (!std::filesystem::is_directory(o.folder)) throw InputError(o.folder + ": not a folder");
-    std::vector<std::string> recorded = addReadSpeech(o, base, trainer, training.analysis);
+    std::vector<std::string> recorded;
+    addReadSpeech(o, base, trainer, training.analysis, recorded);
     for (const auto& entry : std::filesystem::directory_iterator(o.folder)) {
         if (!isAudio(entry.path()) || wordsBeside(entry.path())) continue;
         const auto cls = classOfFile(entry.path());
@@ -83,8 +85,7 @@ void runCalibrate(const CalibrateOptions& o) {
             continue;
         }
         trainer.addSustained(dsp::analyzeFrames(entry.path(), training.analysis), cls);
-        if (std::find(recorded.begin(), recorded.end(), cls) == recorded.end())
-            recorded.push_back(cls);
+        addOnce(recorded, cls);
     }
     if (recorded.empty())
         throw InputError(o.folder +
