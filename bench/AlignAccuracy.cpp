@@ -67,6 +67,7 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"distanceWeight", &dsp::AlignerConfig::distanceWeight},
         {"speechInSilenceCost", &dsp::AlignerConfig::speechInSilenceCost},
         {"consonantInSilenceCost", &dsp::AlignerConfig::consonantInSilenceCost},
+        {"silenceInSpeechCost", &dsp::AlignerConfig::silenceInSpeechCost},
         {"fillerCostPerFrame", &dsp::AlignerConfig::fillerCostPerFrame},
         {"edgeFillerCostPerFrame", &dsp::AlignerConfig::edgeFillerCostPerFrame},
         {"silenceLoopCost", &dsp::AlignerConfig::silenceLoopCost},

@@ -26,6 +26,7 @@ struct AlignOptions {
     std::string words;
     std::string format = "tsv";
     float minWordConfidence = dsp::AlignerConfig{}.minWordConfidence;
+    float silenceInSpeechCost = dsp::AlignerConfig{}.silenceInSpeechCost;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
     bool quiet = false, reductions = true;
@@ -63,6 +64,7 @@ void runAlign(const AlignOptions& o) {
     const auto templates = o.frontEnd.loadTemplates();
     dsp::AlignerConfig aligner;
     aligner.minWordConfidence = o.minWordConfidence;
+    aligner.silenceInSpeechCost = o.silenceInSpeechCost;
     EspeakSynthesizer synth;
     const auto r = alignText(synth, o.input, text, o.voice, templates, o.frontEnd.config(), aligner,
                              o.frontEnd.decode(), o.frontEnd.raw(), o.reductions);
@@ -111,6 +113,10 @@ void addAlignCommand(CLI::App& app) {
     cmd->add_option("--min-word-confidence", o->minWordConfidence,
                     "Words placed with less confidence get audio-only analysis instead")
         ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    cmd->add_option("--silence-in-speech-cost", o->silenceInSpeechCost,
+                    "Cost per frame of silence where the energy gate hears speech")
+        ->check(CLI::Range(0.0, 100.0))
         ->capture_default_str();
     cmd->add_flag("!--no-reductions", o->reductions,
                   "Follow espeak-ng's reading only, without the common reductions "

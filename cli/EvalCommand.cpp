@@ -27,6 +27,7 @@ struct EvalOptions {
     std::string puppet = "jaw-servo", jawActuator;
     double minAccuracy = 0, minGroupAccuracy = 0;
     double minJawR = -1, minExactJawR = -1, minExactClosures = 0;
+    double minClosures = 0, maxFalseClosures = 1;  // the jaw from audio (or aligned)
     bool perFile = true, jaw = true;
     // --align: each NAME.wav is aligned on the words of NAME.txt beside it (lipsync align)
     // instead of analysed from the audio alone; voices: "VOICE" for every speaker, or
@@ -101,8 +102,12 @@ struct Evaluator {
         // does; the envelope follower, like a jaw board, hears the audio itself.
         const auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
         const auto heard = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
+        // The labels' jaw is the exact phonemes' (as `say` gives it): not what the audio was
+        // heard to say.
+        auto loudnessOnly = levels;
+        loudnessOnly.jaw.clear();
         return {score(runtime.animate(schedule, &levels)),
-                score(runtime.animate(reference, &levels)), score(envelopeTrack(heard))};
+                score(runtime.animate(reference, &loudnessOnly)), score(envelopeTrack(heard))};
     }
 
     // The voice whose reading of the words a speaker's files are aligned with.
@@ -302,6 +307,16 @@ void checkFloors(const Report& report, const EvalOptions& o) {
         if (closures.second < o.minExactClosures)
             why << "closures caught from the labels " << pct(closures.second) << " ("
                 << closures.first << ") are below the floor " << pct(o.minExactClosures) << ". ";
+        const auto caught = worst(report, [](const Score& s) { return s.jaw.audio.closureRate(); });
+        const auto falseClosed =
+            worst(report, [](const Score& s) { return -s.jaw.audio.falseClosureRate(); });
+        const char* how = o.align ? "aligned " : "from audio ";
+        if (caught.second < o.minClosures)
+            why << "closures caught " << how << pct(caught.second) << " (" << caught.first
+                << ") are below the floor " << pct(o.minClosures) << ". ";
+        if (-falseClosed.second > o.maxFalseClosures)
+            why << "false closures " << how << pct(-falseClosed.second) << " (" << falseClosed.first
+                << ") are above the ceiling " << pct(o.maxFalseClosures) << ". ";
     }
     if (!why.str().empty()) throw std::runtime_error(why.str());
 }
@@ -377,6 +392,14 @@ void addEvalCommand(CLI::App& app) {
                     "Exit 1 when the worst speaker's closures caught from the labels (0..1) fall "
                     "below this")
         ->check(CLI::Range(0.0, 1.0));
+    cmd->add_option("--min-closures", o->minClosures,
+                    "Exit 1 when the worst speaker's closures caught from audio (aligned with "
+                    "--align), 0..1, fall below this")
+        ->check(CLI::Range(0.0, 1.0));
+    cmd->add_option("--max-false-closures", o->maxFalseClosures,
+                    "Exit 1 when the worst speaker's false closures from audio (aligned with "
+                    "--align), 0..1, rise above this")
+        ->check(CLI::Range(0.0, 1.0));
     cmd->add_flag("!--no-per-file", o->perFile, "Leave out the per-file table");
     cmd->add_flag("--align", o->align,
                   "Score 'lipsync align' instead: each NAME.wav aligned on the words of NAME.txt "
@@ -391,6 +414,10 @@ void addEvalCommand(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--reduction-cost", o->aligner.reductionCost,
                     "With --align: cost of saying a word another way than espeak-ng reads it")
+        ->check(CLI::Range(0.0, 100.0))
+        ->capture_default_str();
+    cmd->add_option("--silence-in-speech-cost", o->aligner.silenceInSpeechCost,
+                    "With --align: cost per frame of silence where the energy gate hears speech")
         ->check(CLI::Range(0.0, 100.0))
         ->capture_default_str();
     cmd->add_flag("!--no-reductions", o->reductions,

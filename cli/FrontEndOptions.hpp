@@ -47,6 +47,11 @@ struct FrontEndOptions {
                        "the noise floor (0: off)")
             ->check(CLI::Range(0.0, 80.0))
             ->capture_default_str();
+        cmd.add_option("--jaw-spread", classifier.jawSpreadDb,
+                       "How far (dB of spectral distance) a class may lie from the nearest and "
+                       "still count towards the jaw height heard in a frame")
+            ->check(CLI::Range(0.01, 20.0))
+            ->capture_default_str();
         addDecoderTo(cmd);
     }
 

@@ -46,6 +46,9 @@ struct RuntimeOptions {
                      "Do not force the mouth to rest in pauses and after speech");
         cmd.add_flag("!--no-loudness", spec.loudness,
                      "Do not let louder speech open the mouth wider (poses' loudness_gain)");
+        cmd.add_flag("!--no-heard-jaw", spec.heardJaw,
+                     "Take the jaw from the schedule's phonemes alone, not partly from the jaw "
+                     "heights the front end's class scores point to (poses' heard_jaw)");
     }
 
     const PhonemeSet& phonemeSet() const { return PhonemeSet::named(spec.phonemes); }

@@ -92,6 +92,9 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_option("--clusters", o->training.clustersPerClass, "Cluster means per class")
         ->check(CLI::Range(1, 64))
         ->capture_default_str();
+    cmd->add_flag("--full-covariance", o->training.fullCovariance,
+                  "Match under the pooled within-class covariance of all features (a Mahalanobis "
+                  "distance, stored as the set's 'whitening') instead of per-feature weights");
     cmd->add_option("--order", o->training.analysis.order, "LPC order")
         ->check(CLI::Range(2, dsp::kMaxOrder))
         ->capture_default_str();

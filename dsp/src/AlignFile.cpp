@@ -13,6 +13,13 @@ namespace {
 constexpr std::size_t kReadBlock = 4096;
 // Speech is what lies within this many dB of the loudest 10 ms block, and above the floor.
 constexpr double kSpeechBelowPeakDb = 35, kSpeechFloorDbfs = -55;
+// ... and clear of the room: the room's level is this quantile of the 10 ms blocks' levels
+// (its quietest stretches; a quantile, not the minimum, so that one block of digital silence
+// at a fade-in is not taken for the room), and speech lies above it by the front end's
+// silence margin (ClassifierConfig). Without it a clip with a room less than 35 dB below the
+// voice (short clips at -52 dBFS under a -18 dBFS word) counted wholly as speech, and the
+// speaking rate came out twice too slow (clamped at kMaxTimeScale).
+constexpr double kRoomQuantile = 0.05;
 // The speaking rate is believed within these bounds (espeak-ng's 80..450 words per minute
 // against its default 175 spans about 0.4..2.2).
 constexpr double kMinTimeScale = 0.5, kMaxTimeScale = 2.0;
@@ -122,7 +129,12 @@ double estimateTimeScale(std::span<const ScriptWord> script, const std::filesyst
     }
     if (levels.empty()) return 1.0;
     const double peak = *std::max_element(levels.begin(), levels.end());
-    const double gate = std::max(peak - kSpeechBelowPeakDb, kSpeechFloorDbfs);
+    auto sorted = levels;
+    const auto roomAt =
+        sorted.begin() + static_cast<std::ptrdiff_t>(kRoomQuantile * (sorted.size() - 1));
+    std::nth_element(sorted.begin(), roomAt, sorted.end());
+    const double room = *roomAt + ClassifierConfig{}.silenceMarginDb;
+    const double gate = std::max({peak - kSpeechBelowPeakDb, kSpeechFloorDbfs, room});
     std::size_t first = levels.size(), last = 0;
     for (std::size_t i = 0; i < levels.size(); ++i)
         if (levels[i] >= gate) {

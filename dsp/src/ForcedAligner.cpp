@@ -89,6 +89,8 @@ void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool sil
                     (*set)[c].vowel ? config.speechInSilenceCost : config.consonantInSilenceCost;
                 ex += kSilentExcessDb;
             }
+        } else if (c == sil) {
+            cost += config.silenceInSpeechCost;
         }
         emission[c] = cost;
         excessOut.push_back(ex);

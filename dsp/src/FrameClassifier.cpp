@@ -26,6 +26,7 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
     scaledFrame_.assign(matrix_->features(), 0.0f);
     distances_.assign(set.size(), std::numeric_limits<float>::infinity());
     sil_ = static_cast<int>(set.silence());
+    for (std::size_t c = 0; c < set.size(); ++c) jawOf_.push_back(set[c].jaw.value_or(0.0f));
     reset();
 }
 
@@ -34,6 +35,23 @@ void FrameClassifier::reset() {
     peakDb_ = -120;
     floorInitialised_ = false;
     lastTime_ = 0;
+}
+
+// Σ w_c·jaw_c / Σ w_c over the classes, w_c = exp(−(d_c − best) / spread): a soft decision,
+// whose errors between classes of like height cost the jaw nothing (a posterior-weighted
+// estimate instead of the arg-min; Bourlard & Morgan 1994 on distances as scores). Classes more
+// than 12 spreads away weigh under 1e-5 and are skipped.
+float FrameClassifier::expectedJaw(float best) const {
+    const float spread = std::max(config_.jawSpreadDb, 1e-3f);
+    float sum = 0, weighted = 0;
+    for (std::size_t c = 0; c < distances_.size(); ++c) {
+        const float z = (distances_[c] - best) / spread;
+        if (!(z < 12)) continue;  // also +inf: a class without templates
+        const float w = std::exp(-z);
+        sum += w;
+        weighted += w * jawOf_[c];
+    }
+    return sum > 0 ? weighted / sum : 0.0f;
 }
 
 FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
@@ -73,10 +91,9 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         label.silent = true;
         return label;
     }
-    const auto scale = matrix_->scale();
-    for (std::size_t b = 0; b < scale.size(); ++b) scaledFrame_[b] = frame.spectrum[b] * scale[b];
+    matrix_->transform(frame.spectrum, scaledFrame_);
     matrix_->nearest(scaledFrame_, distances_);
-    const auto features = static_cast<float>(scale.size());
+    const auto features = static_cast<float>(matrix_->features());
     for (auto& d : distances_)  // weighted RMS difference, in dB
         if (std::isfinite(d)) d = std::sqrt(d / features);
 
@@ -103,14 +120,15 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
                            : 0.0f;
 
     label.silent = !frame.valid || frame.energyDb < gate;
-    if (label.silent) {
-        label.runnerUp = label.phoneme;
-        label.runnerUpDistance = label.distance;
-        label.phoneme = sil;
-        // Sure when far below the gate, unsure near it.
-        label.confidence =
-            std::clamp((gate - frame.energyDb) / config_.silenceMarginDb, 0.0f, 1.0f);
+    if (!label.silent) {
+        label.jaw = expectedJaw(label.distance);
+        return label;
     }
+    label.runnerUp = label.phoneme;
+    label.runnerUpDistance = label.distance;
+    label.phoneme = sil;
+    // Sure when far below the gate, unsure near it.
+    label.confidence = std::clamp((gate - frame.energyDb) / config_.silenceMarginDb, 0.0f, 1.0f);
     return label;
 }
 

@@ -73,13 +73,17 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
     // One level a frame is all that grows with the input (besides the schedule): reserved at
     // once when the length is known, so an hour does not pass through doubling copies.
-    if (const auto frames = decoder.frames())
-        result.levels.db.reserve(static_cast<std::size_t>(
+    if (const auto frames = decoder.frames()) {
+        const auto count = static_cast<std::size_t>(
             static_cast<double>(*frames) / decoder.sampleRate() / templates.analysis.hopSeconds +
-            2));
+            2);
+        result.levels.db.reserve(count);
+        result.levels.jaw.reserve(count);
+    }
     analyzer.onSegment([&](const PhonemeSegment& s) { result.schedule.push_back(s); });
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
         result.levels.add(f.label.time, f.label.energyDb);
+        result.levels.jaw.push_back(f.label.jaw);
         if (keepFrames) result.frames.push_back(f);
     });
     std::vector<float> block(kReadBlock);

@@ -13,6 +13,9 @@ TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& s
     : features_(templates.binWeights.size()) {
     scale_.resize(features_);
     for (std::size_t b = 0; b < features_; ++b) scale_[b] = std::sqrt(templates.binWeights[b]);
+    for (const auto& row : templates.whitening)
+        whitening_.insert(whitening_.end(), row.begin(), row.end());
+    std::vector<float> stored(features_);
     for (const auto& c : templates.classes) {
         const auto idx = set.find(c.phoneme);
         if (!idx)
@@ -21,9 +24,9 @@ TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& s
             const std::size_t at = blocks_.size();
             blocks_.resize(at + features_ * kLanes);
             for (std::size_t lane = 0; lane < kLanes; ++lane) {
-                const auto& t = c.spectra[std::min(first + lane, c.spectra.size() - 1)];
+                transform(c.spectra[std::min(first + lane, c.spectra.size() - 1)], stored);
                 for (std::size_t b = 0; b < features_; ++b)
-                    blocks_[at + b * kLanes + lane] = t[b] * scale_[b];
+                    blocks_[at + b * kLanes + lane] = stored[b];
             }
             blockClass_.push_back(static_cast<int>(*idx));
         }
@@ -78,6 +81,19 @@ LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features
     }
 }
 }  // namespace
+
+void TemplateMatrix::transform(std::span<const float> frame, std::span<float> out) const {
+    if (whitening_.empty()) {
+        for (std::size_t b = 0; b < features_; ++b) out[b] = frame[b] * scale_[b];
+        return;
+    }
+    for (std::size_t r = 0; r < features_; ++r) {  // lower triangular: columns 0..r
+        const float* row = whitening_.data() + r * features_;
+        float sum = 0;
+        for (std::size_t c = 0; c <= r; ++c) sum += row[c] * frame[c];
+        out[r] = sum;
+    }
+}
 
 void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out) const {
     std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());

@@ -1,8 +1,9 @@
 // Every template of a set, laid out for the classifier's distance loop. Σ w·(x−t)² =
-// Σ (√w·x − √w·t)²: templates are stored scaled by √w. Per class, its templates go in blocks of
-// eight (the last block padded with copies of the class's last template, which cannot change a
-// minimum), each block feature-major ([feature][8 templates]), so that one vector operation
-// serves eight templates and no per-template horizontal sum is needed.
+// Σ (√w·x − √w·t)²: templates are stored scaled by √w, or multiplied by the set's whitening W
+// (‖W(x − t)‖² = ‖Wx − Wt‖²), so a frame is transformed once and compared with every template. Per
+// class, its templates go in blocks of eight (the last block padded with copies of the class's last
+// template, which cannot change a minimum), each block feature-major ([feature][8 templates]), so
+// that one vector operation serves eight templates and no per-template horizontal sum is needed.
 //
 // Each template's sum is formed exactly as a row-by-row loop with eight partial sums forms it
 // (feature f into partial sum f mod 8, in order; the partial sums added as
@@ -24,8 +25,9 @@ class TemplateMatrix {
     // Throws InputError for a class the phoneme set does not have.
     TemplateMatrix(const TemplateSet& templates, const PhonemeSet& set);
     std::size_t features() const { return features_; }
-    // √ of each feature's weight: the frame is scaled by these before nearest().
-    std::span<const float> scale() const { return scale_; }
+    // The frame as nearest() takes it: scaled by the weights, or multiplied by the set's
+    // whitening (TemplateSet::whitening, lower triangular). `out` has features() values.
+    void transform(std::span<const float> frame, std::span<float> out) const;
     // Squared weighted distance from a scaled frame to the nearest template of each class,
     // indexed by phoneme set index; +inf for classes without templates.
     void nearest(std::span<const float> scaledFrame, std::span<float> out) const;
@@ -33,8 +35,9 @@ class TemplateMatrix {
   private:
     std::size_t features_ = 0;
     std::vector<float> scale_;
-    std::vector<float> blocks_;    // [block][feature][lane]
-    std::vector<int> blockClass_;  // phoneme set index of each block (blocks of a class adjacent)
+    std::vector<float> whitening_;  // [row][column], row-major; empty: diagonal scale_ only
+    std::vector<float> blocks_;     // [block][feature][lane]
+    std::vector<int> blockClass_;   // phoneme set index of each block (blocks of a class adjacent)
 };
 
 }  // namespace lipsyncd::dsp

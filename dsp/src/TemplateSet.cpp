@@ -1,5 +1,7 @@
 // Spectral templates as data: JSON under config/templates/ (format in its README.md).
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <lipsyncd/dsp.hpp>
 #include <nlohmann/json.hpp>
@@ -86,6 +88,16 @@ std::vector<double> rounded(const std::vector<float>& v) {
         out[i] = std::round(static_cast<double>(v[i]) * 1000.0) / 1000.0;
     return out;
 }
+// Five significant digits: the whitening's entries span orders of magnitude (0.001 to 10).
+std::vector<double> precise(const std::vector<float>& v) {
+    std::vector<double> out(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.5g", static_cast<double>(v[i]));
+        out[i] = std::strtod(text, nullptr);
+    }
+    return out;
+}
 }  // namespace
 
 void TemplateSet::validate(const std::string& source) const {
@@ -98,6 +110,28 @@ void TemplateSet::validate(const std::string& source) const {
     for (std::size_t b = 0; b < bins; ++b)
         if (!(binWeights[b] >= 0) || !std::isfinite(binWeights[b]))
             throw InputError(source, 0, "bin_weights[" + std::to_string(b) + "] must be >= 0");
+    if (!whitening.empty()) {
+        if (whitening.size() != bins)
+            throw InputError(source, 0,
+                             "whitening has " + std::to_string(whitening.size()) +
+                                 " rows, the analysis has " + std::to_string(bins) + " features");
+        for (std::size_t r = 0; r < bins; ++r) {
+            const std::string where = "whitening[" + std::to_string(r) + "]";
+            if (whitening[r].size() != bins)
+                throw InputError(source, 0,
+                                 where + " has " + std::to_string(whitening[r].size()) +
+                                     " values, expected " + std::to_string(bins));
+            for (std::size_t c = 0; c < bins; ++c)
+                if (!std::isfinite(whitening[r][c]) || (c > r && whitening[r][c] != 0))
+                    throw InputError(source, 0,
+                                     where + "[" + std::to_string(c) +
+                                         "]: values must be finite, and 0 above the diagonal "
+                                         "(the matrix is lower triangular)");
+            if (!(whitening[r][r] > 0))
+                throw InputError(source, 0,
+                                 where + "[" + std::to_string(r) + "]: the diagonal must be > 0");
+        }
+    }
     if (classes.empty()) throw InputError(source, 0, "no classes");
     const PhonemeSet& set = PhonemeSet::common();
     for (std::size_t c = 0; c < classes.size(); ++c) {
@@ -131,6 +165,8 @@ TemplateSet TemplateSet::load(const std::filesystem::path& file) {
     t.description = j.value("description", "");
     t.analysis = readAnalysis(member<json>(j, "analysis", "", source), source);
     t.binWeights = member<std::vector<float>>(j, "bin_weights", "", source);
+    if (j.contains("whitening"))
+        t.whitening = member<std::vector<std::vector<float>>>(j, "whitening", "", source);
     const auto classes = member<json>(j, "classes", "", source);
     if (!classes.is_array()) throw InputError(source, 0, "field 'classes' must be an array");
     for (std::size_t i = 0; i < classes.size(); ++i) {
@@ -162,12 +198,17 @@ void TemplateSet::save(const std::filesystem::path& file) const {
         for (const auto& s : c.spectra) spectra.push_back(rounded(s));
         classesJson.push_back({{"phoneme", c.phoneme}, {"frames", c.frames}, {"spectra", spectra}});
     }
-    const json j = {{"format", kFormat},
-                    {"version", kVersion},
-                    {"description", description},
-                    {"analysis", writeAnalysis(analysis)},
-                    {"bin_weights", rounded(binWeights)},
-                    {"classes", classesJson}};
+    json j = {{"format", kFormat},
+              {"version", kVersion},
+              {"description", description},
+              {"analysis", writeAnalysis(analysis)},
+              {"bin_weights", rounded(binWeights)},
+              {"classes", classesJson}};
+    if (!whitening.empty()) {
+        json rows = json::array();
+        for (const auto& row : whitening) rows.push_back(precise(row));
+        j["whitening"] = rows;
+    }
     std::ofstream out(file);
     if (!out) throw InputError(file.string() + ": cannot write");
     out << j.dump(1) << '\n';

@@ -6,6 +6,8 @@
 #include <numeric>
 #include <random>
 
+#include "Whitening.hpp"
+
 namespace lipsyncd::dsp {
 
 namespace {
@@ -116,9 +118,10 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
     t.analysis = options_.analysis;
     t.description = description;
     const auto bins = static_cast<std::size_t>(options_.analysis.featureCount());
-    // Pooled within-class variance per bin: bins where classes differ more than frames of one
-    // class scatter get more weight (inverse variance; notes/dsp.md, Tohkura 1987).
-    std::vector<double> variance(bins, 0.0);
+    // Pooled within-class covariance (every bin pair, or only the diagonal: the per-bin
+    // variances): bins where classes differ more than frames of one class scatter weigh more
+    // (inverse variance; notes/dsp.md, Tohkura 1987).
+    std::vector<double> covariance(bins * bins, 0.0);
     std::size_t pooled = 0;
     for (std::size_t c = 0; c < spectra_.size(); ++c) {
         const auto& frames = spectra_[c];
@@ -127,7 +130,9 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
         for (const auto& f : frames) all.push_back(&f);
         const auto m = mean(all, bins);
         for (const auto& f : frames)
-            for (std::size_t b = 0; b < bins; ++b) variance[b] += (f[b] - m[b]) * (f[b] - m[b]);
+            for (std::size_t i = 0; i < bins; ++i)
+                for (std::size_t j = options_.fullCovariance ? 0 : i; j <= i; ++j)
+                    covariance[i * bins + j] += (f[i] - m[i]) * (f[j] - m[j]);
         pooled += frames.size();
 
         TemplateSet::ClassTemplates cls;
@@ -139,14 +144,31 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
         cls.spectra = kMeans(frames, k, options_.seed + static_cast<std::uint32_t>(c));
         t.classes.push_back(std::move(cls));
     }
+    const double n = static_cast<double>(std::max<std::size_t>(1, pooled));
+    for (std::size_t i = 0; i < bins; ++i)
+        for (std::size_t j = 0; j <= i; ++j)
+            covariance[j * bins + i] = covariance[i * bins + j] /= n;
     if (t.classes.empty())
         throw InputError("training: no class has " + std::to_string(options_.minFramesPerCluster) +
                          " usable frames; give more (or longer) labelled audio");
+    // Every variance at least 1 dB²: a feature that barely moves in training must not dominate.
+    for (std::size_t b = 0; b < bins; ++b)
+        covariance[b * bins + b] = std::max(covariance[b * bins + b], 1.0);
+    double inverseSum = 0;
+    for (std::size_t b = 0; b < bins; ++b) inverseSum += 1.0 / covariance[b * bins + b];
     t.binWeights.resize(bins);
+    if (options_.fullCovariance) {
+        // Scaled so that a frame's expected distance to its own class's mean is what the
+        // per-bin weights give (the harmonic mean of the variances, in dB²): the decoder's and
+        // the aligner's costs per dB keep their meaning.
+        const double harmonicMean = static_cast<double>(bins) / inverseSum;
+        t.whitening = whiteningFromCovariance(covariance, bins, std::sqrt(harmonicMean));
+        std::fill(t.binWeights.begin(), t.binWeights.end(), 1.0f);
+        return t;
+    }
     double sum = 0;
     for (std::size_t b = 0; b < bins; ++b) {
-        const double v = variance[b] / static_cast<double>(std::max<std::size_t>(1, pooled));
-        t.binWeights[b] = static_cast<float>(1.0 / std::max(v, 1.0));  // ≥ 1 dB² floor
+        t.binWeights[b] = static_cast<float>(1.0 / covariance[b * bins + b]);
         sum += t.binWeights[b];
     }
     for (auto& w : t.binWeights) w = static_cast<float>(w * bins / sum);  // mean weight 1

@@ -97,10 +97,20 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
         p.loudnessGain = t.optNumber("loudness_gain").value_or(0);
         if (!(p.loudnessGain >= 0 && p.loudnessGain <= 1))
             t.fail("loudness_gain", "must be in [0, 1]");
+        p.heardJaw = t.optNumber("heard_jaw").value_or(0);
+        if (!(p.heardJaw >= 0 && p.heardJaw <= 1)) t.fail("heard_jaw", "must be in [0, 1]");
+        p.heardJawClosedBy = t.optString("heard_jaw_closed_by").value_or("");
         t.finish();
         poses.push_back(std::move(p));
     }
     if (poses.empty()) throw InputError(file.string(), 0, "no [[pose]] defined");
+    for (const auto& p : poses)
+        if (!p.heardJawClosedBy.empty() &&
+            std::none_of(poses.begin(), poses.end(),
+                         [&](const Pose& q) { return q.name == p.heardJawClosedBy; }))
+            throw InputError(file.string(), 0,
+                             "pose '" + p.name + "': heard_jaw_closed_by: no pose named '" +
+                                 p.heardJawClosedBy + "'");
     auto constraints = readConstraints(root, poses);
     const auto rest = readRest(root);
     root.finish();

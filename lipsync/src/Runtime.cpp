@@ -40,6 +40,7 @@ PoseTrack Runtime::animate(std::span<const PhonemeSegment> schedule,
     auto track = spec_.kind == "filter"
                      ? animateFilter(schedule, curves_, poses_, spec_.config, *phonemes_)
                      : lipsync::animate(schedule, curves_, poses_, spec_.config, *phonemes_);
+    if (levels && spec_.heardJaw) blendHeardJaw(poses_, *levels, track);
     if (levels && spec_.loudness) shapeByLoudness(poses_, *levels, track);
     return track;
 }

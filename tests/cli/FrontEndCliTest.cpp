@@ -2,6 +2,7 @@
 // 2 usage error), and errors on stderr that name the file and what is wrong.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <lipsyncd/core.hpp>
@@ -135,6 +136,26 @@ TEST(LipsyncCli, EvalScoresThePuppetsJawPerSpeaker) {
     const auto floor = runLipsync({"eval", "--corpus", dir.string(), "--min-exact-jaw-r", "0.999"});
     EXPECT_EQ(floor.exitCode, 1);
     EXPECT_NE(floor.err.find("jaw r from the labels"), std::string::npos) << floor.err;
+    // The jaw from audio has a floor on its closures and a ceiling on its false closures too.
+    const auto audio = json["speakers"]["alice"]["jaw"]["audio"];
+    const double caught = audio["closures_caught"].get<double>();
+    const double falseClosed = audio["false_closures"].get<double>();
+    const auto within = runLipsync({"eval", "--corpus", dir.string(), "--min-closures",
+                                    std::to_string(caught - 0.01), "--max-false-closures",
+                                    std::to_string(falseClosed + 0.01)});
+    EXPECT_EQ(within.exitCode, 0) << within.err;
+    const auto tooOpen = runLipsync({"eval", "--corpus", dir.string(), "--min-closures",
+                                     std::to_string(std::min(1.0, caught + 0.01))});
+    if (caught < 0.995) {
+        EXPECT_EQ(tooOpen.exitCode, 1);
+        EXPECT_NE(tooOpen.err.find("closures caught from audio"), std::string::npos);
+    }
+    ASSERT_GT(falseClosed, 0.0) << "the example's audio jaw no longer shuts by mistake: "
+                                   "pick a file where it does, so the ceiling is tested";
+    const auto tooShut = runLipsync({"eval", "--corpus", dir.string(), "--max-false-closures",
+                                     std::to_string(falseClosed / 2)});
+    EXPECT_EQ(tooShut.exitCode, 1);
+    EXPECT_NE(tooShut.err.find("false closures from audio"), std::string::npos) << tooShut.err;
     const auto bad = runLipsync({"eval", "--corpus", dir.string(), "--jaw-actuator", "tail"});
     EXPECT_EQ(bad.exitCode, 1);
     EXPECT_NE(bad.err.find("no actuator named 'tail'"), std::string::npos) << bad.err;

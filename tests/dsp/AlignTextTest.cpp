@@ -159,6 +159,26 @@ TEST(AlignText, TextInAScriptTheVoiceCannotReadIsAnError) {
     EXPECT_TRUE(warned);
 }
 
+// A short clip in a noisy room (the room 34 dB under the word, within the 35 dB the speech
+// lies under its peak): the room is not speech, so the speaking rate is the word's own.
+TEST(AlignText, TheRoomOfAShortClipDoesNotCountAsSpeech) {
+    const auto s = speak("Moon.");
+    std::vector<float> clip(static_cast<std::size_t>(s.rate), 0.0f);  // 0.5 s room each side
+    clip.insert(clip.begin() + s.rate / 2, s.samples.begin(), s.samples.end());
+    double peak = 0;
+    for (auto v : s.samples) peak = std::max(peak, double(std::abs(v)));
+    std::uint32_t seed = 1;
+    // Uniform noise 40 dB under the word's peak sample: about 32 dB under its loudest 10 ms.
+    for (auto& v : clip) {
+        seed = seed * 1664525u + 1013904223u;
+        v += static_cast<float>(peak * 0.017 * ((seed >> 8) / double(1 << 24) * 2 - 1));
+    }
+    const auto quiet = align(wav("align_room_quiet.wav", s.samples, s.rate), "Moon.");
+    const auto noisy = align(wav("align_room_noisy.wav", clip, s.rate), "Moon.");
+    EXPECT_NEAR(noisy.timeScale, quiet.timeScale, 0.25 * quiet.timeScale)
+        << "the room was taken for speech";
+}
+
 TEST(AlignText, SilenceOnlyFallsBackWithAWarning) {
     const auto r = align(wav("align_silence.wav", std::vector<float>(44100, 0.0f), 22050), kLine);
     EXPECT_TRUE(r.fellBack);

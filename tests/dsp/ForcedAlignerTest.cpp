@@ -186,6 +186,33 @@ TEST(ForcedAligner, FramesWithoutSpectraAreSilence) {
     EXPECT_NEAR(a.words[0].start, 0.10, 1e-6);
 }
 
+// A word's weak end (an offglide, a final nasal) lies far from every template, silence
+// included, but above the energy gate: it is still the word, not the pause after it.
+TEST(ForcedAligner, SpeechAboveTheGateStaysWithTheWordNotThePause) {
+    Frames f;
+    f.add({{"sil", 20}});
+    f.add({{"z", 8}, {"ih", 10}});
+    const double wordEnd = (20 + 8 + 10 + 12) * kHop;
+    const auto& set = PhonemeSet::common();
+    for (int i = 0; i < 12; ++i) {  // the tail: nearest class ih, silence hardly further
+        std::vector<float> d(set.size(), 12.0f);
+        d[*set.find("ih")] = 7.0f;
+        d[set.silence()] = 7.3f;
+        f.distances.push_back(d);
+        f.silent.push_back(false);
+    }
+    f.add({{"sil", 20}});
+    const std::vector<ScriptWord> script = {word("see", {{"z", 8}, {"ih", 10}})};
+    const auto a = f.align(script);
+    ASSERT_TRUE(a.words[0].placed);
+    EXPECT_NEAR(a.words[0].end, wordEnd, 0.0101);
+    AlignerConfig free;
+    free.silenceInSpeechCost = 0;
+    ForcedAligner without(script, set, kHop, 1.0, free);
+    EXPECT_LT(f.align(script, &without).words[0].end, wordEnd - 0.05)
+        << "without the cost the pause takes the tail (the test no longer tests it)";
+}
+
 TEST(ForcedAligner, BadScriptsAreInputErrors) {
     const auto& set = PhonemeSet::common();
     EXPECT_THROW(ForcedAligner({}, set, kHop), InputError);

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 
 #include "TestSpeech.hpp"
@@ -70,6 +71,64 @@ TEST(FrontEnd, SameSpeechInAnyFormatRateOrLayoutGivesTheSameSchedule) {
         EXPECT_NEAR(result.durationSeconds, reference.durationSeconds, 0.01) << v.name;
         EXPECT_GT(agreement(result.schedule, reference.schedule), 0.9) << v.name;
     }
+}
+
+TEST(FrontEnd, SixteenBitSamplesDecodeAsLibsndfileReadsThemAsFloats) {
+    // Every 16-bit value, in a mono file and as the second channel of a stereo one (the first
+    // channel counts down), decoded by AudioDecoder and by libsndfile's float reading.
+    std::vector<short> mono(65536), stereo(2 * 65536);
+    for (int i = 0; i < 65536; ++i) {
+        mono[i] = static_cast<short>(i - 32768);
+        stereo[2 * i] = static_cast<short>(32767 - i);
+        stereo[2 * i + 1] = mono[i];
+    }
+    auto write = [](const std::string& name, const std::vector<short>& samples, int channels) {
+        const auto path = std::filesystem::temp_directory_path() / ("lipsyncd_test_" + name);
+        SF_INFO info{};
+        info.samplerate = 16000;
+        info.channels = channels;
+        info.format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
+        SNDFILE* f = sf_open(path.c_str(), SFM_WRITE, &info);
+        sf_writef_short(f, samples.data(), static_cast<sf_count_t>(samples.size() / channels));
+        sf_close(f);
+        return path;
+    };
+    auto libsndfileFloats = [](const std::filesystem::path& path) {
+        SF_INFO info{};
+        SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
+        std::vector<float> out(static_cast<std::size_t>(info.frames * info.channels));
+        sf_command(f, SFC_SET_NORM_FLOAT, nullptr, SF_TRUE);
+        sf_readf_float(f, out.data(), info.frames);
+        sf_close(f);
+        return out;
+    };
+    auto bitsOf = [](float v) {
+        std::uint32_t b;
+        std::memcpy(&b, &v, sizeof b);
+        return b;
+    };
+    const auto monoFile = write("all_s16_mono.wav", mono, 1);
+    const auto stereoFile = write("all_s16_stereo.wav", stereo, 2);
+    const auto expectMono = libsndfileFloats(monoFile);
+    const auto expectStereo = libsndfileFloats(stereoFile);
+    const auto gotMono = dsp::readAudioFile(monoFile).samples;
+    const auto gotSecond = dsp::readAudioFile(stereoFile, {1}).samples;
+    const auto gotMix = dsp::readAudioFile(stereoFile).samples;
+    ASSERT_EQ(gotMono.size(), 65536u);
+    ASSERT_EQ(gotSecond.size(), 65536u);
+    ASSERT_EQ(gotMix.size(), 65536u);
+    int differ = 0;
+    for (std::size_t i = 0; i < 65536; ++i) {
+        const float a = expectStereo[2 * i], b = expectStereo[2 * i + 1];
+        float mix = 0;
+        mix += a;
+        mix += b;
+        mix /= 2.0f;
+        differ += bitsOf(gotMono[i]) != bitsOf(expectMono[i]);
+        differ += bitsOf(gotSecond[i]) != bitsOf(b);
+        differ += bitsOf(gotMix[i]) != bitsOf(mix);
+    }
+    EXPECT_EQ(differ, 0);
 }
 
 TEST(FrontEnd, ChannelSelectionIgnoresTheOtherChannel) {

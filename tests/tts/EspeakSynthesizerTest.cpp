@@ -2,6 +2,7 @@
 // training and dev corpora comes from these events.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <lipsyncd/tts.hpp>
 
@@ -48,6 +49,41 @@ TEST(EspeakSynthesizer, PausesInTheEventsAreQuietInTheAudio) {
             << "pause at " << p.start << "-" << p.end << " s is not quiet";
     }
     EXPECT_GE(pauses, 2);
+}
+
+// espeak-ng reports a coda /l/ before a pause at the same position as the pause ("well" is w,
+// E over the whole vowel-and-l, l at 0 ms): the words the aligner follows must keep it, with
+// a share of the vowel's time, or every "ball", "hotel" and "girl" loses its /l/.
+TEST(EspeakSynthesizer, AWordKeepsTheCodaLEspeakReportsAtZeroLength) {
+    for (const std::string text : {"well", "ball", "girl"}) {
+        const auto s = speak(text);
+        ASSERT_EQ(s.words.size(), 1u) << text;
+        const auto& p = s.words[0].phonemes;
+        const auto l = std::find_if(p.begin(), p.end(),
+                                    [](const PhonemeSegment& x) { return x.phoneme == "l"; });
+        ASSERT_NE(l, p.end()) << text << ": no l";
+        EXPECT_GT(l->duration(), 0.03) << text;
+        ASSERT_NE(l, p.begin());
+        EXPECT_DOUBLE_EQ((l - 1)->end, l->start) << text;  // it shares, nothing overlaps
+        EXPECT_GT((l - 1)->duration(), 0.03) << text;
+    }
+}
+
+// espeak-ng voices a Russian consonant + /r/ cluster with a short vowel ("пр" is p @- r); a
+// speaker says none (festvox-ru's own labels have none), so the words the aligner follows
+// must not open the jaw there.
+TEST(EspeakSynthesizer, RussianClustersWithRGetNoVowelInTheAlignersWords) {
+    const auto map = espeakMapForVoice("ru");
+    const auto script = scriptForText(synthesizer(), "Прямо, утро, книга.", "ru", map, nullptr);
+    ASSERT_EQ(script.size(), 3u);
+    const auto& pryamo = script[0].phonemes;  // p r ja m V
+    ASSERT_GE(pryamo.size(), 2u);
+    EXPECT_EQ(pryamo[0].phoneme, "bmp");
+    EXPECT_EQ(pryamo[1].phoneme, "r");
+    const auto& utro = script[1].phonemes;  // u t r V
+    ASSERT_GE(utro.size(), 3u);
+    EXPECT_EQ(utro[1].phoneme, "d");
+    EXPECT_EQ(utro[2].phoneme, "r");
 }
 
 TEST(EspeakSynthesizer, UnknownVoiceIsAnInputErrorNamingIt) {

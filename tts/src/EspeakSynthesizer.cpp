@@ -1,8 +1,10 @@
 #include <espeak-ng/speak_lib.h>
 
 #include <atomic>
+#include <cctype>
 #include <cstring>
 #include <lipsyncd/tts.hpp>
+#include <span>
 
 namespace lipsyncd {
 
@@ -95,6 +97,12 @@ std::size_t byteOffset(const std::string& text, int characters) {
     return i;
 }
 
+// A phoneme mnemonic that is a sound: not a pause (_, _:) nor a mark.
+bool isSound(const std::string& name) {
+    const auto first = static_cast<unsigned char>(name.empty() ? '_' : name[0]);
+    return std::isalnum(first) != 0 || first == '@';
+}
+
 // Each word event owns the phoneme events from it to the next word event; pauses before the
 // first word belong to none.
 std::vector<SpokenWord> spokenWords(const std::string& text, const Collector& c, double total) {
@@ -105,11 +113,28 @@ std::vector<SpokenWord> spokenWords(const std::string& text, const Collector& c,
         const auto to = byteOffset(text, mark.position - 1 + mark.length);
         SpokenWord word{text.substr(from, to - from), {}};
         const auto last = w + 1 < c.words.size() ? c.words[w + 1].firstEvent : c.events.size();
+        std::size_t shareFrom = 0;  // the segment a run of zero-length phonemes shares
         for (std::size_t i = mark.firstEvent; i < last; ++i) {
             const double start = std::min(c.events[i].first, total);
             const double end =
                 i + 1 < c.events.size() ? std::min(c.events[i + 1].first, total) : total;
-            if (end > start) word.phonemes.push_back({start, end, c.events[i].second, 1.0f});
+            if (end > start) {
+                shareFrom = word.phonemes.size();
+                word.phonemes.push_back({start, end, c.events[i].second, 1.0f});
+            } else if (!word.phonemes.empty() && isSound(c.events[i].second)) {
+                // espeak-ng reports a coda /l/ at the same position as the event after it (its
+                // sound is rendered inside the vowel before it: "well" is w, E over 245 ms, l at
+                // 0 ms), so the word would lose it. It is said, so it stays, with an equal share
+                // of the segment it is rendered in.
+                word.phonemes.push_back({end, end, c.events[i].second, 1.0f});
+                auto run = std::span(word.phonemes).subspan(shareFrom);
+                const double from = run.front().start, step = (run.back().end - from) / run.size();
+                for (std::size_t k = 0; k < run.size(); ++k) {
+                    run[k].start = from + step * static_cast<double>(k);
+                    run[k].end = k + 1 < run.size() ? from + step * static_cast<double>(k + 1)
+                                                    : run.back().end;
+                }
+            }
         }
         words.push_back(std::move(word));
     }

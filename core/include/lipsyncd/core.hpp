@@ -169,6 +169,10 @@ struct LevelTrack {
     double start = 0;       // seconds: time of frame 0
     double rate = 100;      // frames per second
     std::vector<float> db;  // frame RMS in dBFS
+    // Per frame (the same frames), when the audio went through the front end: the jaw height its
+    // class scores point to (dsp FrameLabel::jaw), which the runtime can blend into the jaw
+    // pose (lipsync::blendHeardJaw). Empty otherwise (speech whose phonemes are known).
+    std::vector<float> jaw;
     // The level at time t (nearest frame; the first/last frame outside the track).
     float at(double t) const;
     // Appends the next frame's level; the first frame's time sets `start`.

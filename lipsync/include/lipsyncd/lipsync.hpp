@@ -39,6 +39,11 @@ struct Pose {
     double smoothingWindow = 0.18;  // 2·t_w, seconds (section 2.2.1)
     // How much of the pose's weight speech loudness controls (shapeByLoudness): 0 none, 1 all.
     double loudnessGain = 0;
+    // How much of the weight the jaw heard in the audio sets (blendHeardJaw): 0 none, 1 all.
+    double heardJaw = 0;
+    // A pose (the lips' closure) whose weight w holds the heard jaw back to (1 − w) of its share:
+    // a closure the schedule places stays closed. Empty: none.
+    std::string heardJawClosedBy;
 };
 
 // The mouth rests when speech stops: from the start of a silence at least `minPause` long (and
@@ -229,6 +234,17 @@ struct LoudnessConfig {
 // Offline: L from the whole utterance. `levels` are frame RMS in dBFS (dsp::measureLevels).
 void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
                      const LoudnessConfig& config = {});
+// The jaw the front end heard (LevelTrack::jaw: per frame, the jaw height its class scores point
+// to, smoothed over `smoothingSeconds`) blended into each pose with a heard_jaw share g:
+// w' = (1 − g)·w + g·heard. Nothing where the track has no jaw (known phonemes).
+// The window the heard jaw is averaged over, offline and in the live stream alike.
+inline constexpr double kHeardJawSmoothingSeconds = 0.04;
+void blendHeardJaw(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
+                   double smoothingSeconds = kHeardJawSmoothingSeconds);
+// One frame of weights (poses in pose-set order) and the jaw heard around its time: what the
+// offline blend does per frame, for a live stream (the service's live mode).
+void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights);
+
 // Streaming: L is a decaying peak of the levels seen so far; frames are shaped as they leave.
 class LoudnessShaper {
   public:
@@ -306,6 +322,7 @@ struct RuntimeSpec {
     std::string kind = "bigram";      // bigram (paper 000) | filter (paper 001, section 5)
     RuntimeConfig config;
     bool loudness = true;  // louder speech opens wider (the poses' loudness_gain)
+    bool heardJaw = true;  // the jaw heard in the audio sets part of it (the poses' heard_jaw)
 };
 
 class Runtime {
@@ -323,7 +340,8 @@ class Runtime {
     const BigramCurveSet& curves() const { return curves_; }
 
     // Offline, the spec's kind; with `levels` (the speech's frame levels) and spec.loudness,
-    // louder speech opens wider within what each phoneme allows.
+    // louder speech opens wider within what each phoneme allows; with their jaw track (audio
+    // analysed by the front end) and spec.heardJaw, the heard jaw is blended in first.
     PoseTrack animate(std::span<const PhonemeSegment> schedule,
                       const LevelTrack* levels = nullptr) const;
     // Segment by segment (the bigram runtime) with `delaySeconds` of look-ahead, 0: causal.
