@@ -120,13 +120,14 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
         Levinson,
         Spectrum,
         Classify,
+        Jaw,
         Viterbi,
         Segment
     };
     StageClock clock({"decode (libsndfile, to mono)", "resample to 10 kHz (libsoxr)",
                       "level (RMS, clipping)", "pre-emphasis and window", "autocorrelation",
                       "Levinson-Durbin", "LPC spectrum", "template distances",
-                      "Viterbi decoder (fixed lag)", "segmenter"});
+                      "jaw network (heard jaw)", "Viterbi decoder (fixed lag)", "segmenter"});
 
     // Decode and resample the whole file in the blocks analyzeFile uses.
     auto decoder = dsp::AudioDecoder::open(file);
@@ -164,7 +165,12 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     std::vector<dsp::FrameFeatures> features(kBlock, analyzer.makeFeatures());
     dsp::DirectLpcSpectrum spectrum(c.order, c.spectrumBins);
     const auto bins = static_cast<std::size_t>(c.spectrumBins);
-    dsp::FrameClassifier classifier(templates, set);
+    // The distances alone here; the jaw network (which classify() runs when the set has one)
+    // is its own stage.
+    auto distancesOnly = templates;
+    distancesOnly.jawNetwork.reset();
+    dsp::FrameClassifier classifier(distancesOnly, set);
+    float jawSum = 0;  // kept, so the network's work is not optimised away
     std::vector<dsp::FrameLabel> labels(kBlock);
     std::vector<std::vector<float>> distances(kBlock);
     dsp::ViterbiDecoder viterbi(dsp::TransitionModel::loadDefault(), set, c.hopSeconds);
@@ -221,6 +227,11 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
                 distances[k].assign(classifier.distances().begin(), classifier.distances().end());
             }
         });
+        if (templates.jawNetwork)
+            clock.time(Jaw, [&] {
+                for (std::size_t k = 0; k < count; ++k)
+                    if (!labels[k].silent) jawSum += (*templates.jawNetwork)(features[k].spectrum);
+            });
         clock.time(Viterbi, [&] {
             decided.clear();
             for (std::size_t k = 0; k < count; ++k)
@@ -230,7 +241,8 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
             for (const auto& l : decided) segments += segmenter.push(l).size();
         });
     }
-    std::printf("per-frame cost of each stage (%zu frames, %zu segments):\n", frames, segments);
+    std::printf("per-frame cost of each stage (%zu frames, %zu segments, mean heard jaw %.2f):\n",
+                frames, segments, frames ? jawSum / static_cast<double>(frames) : 0.0);
     clock.report(frames);
 }
 }  // namespace

@@ -26,6 +26,7 @@ struct AnalyzeOptions {
     std::string schedule;
     std::string format = "tsv";
     std::string frames;
+    std::string features;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
     bool quiet = false;
@@ -45,11 +46,28 @@ void writeFrames(std::ostream& out, const dsp::AnalysisResult& result, const Pho
     }
 }
 
+// One row a frame: the decided class, whether the gate called it silent, the heard jaw, then
+// the feature vector the templates are matched on (spectrum in dB, then the extra features).
+void writeFeatures(std::ostream& out, const dsp::AnalysisResult& result, const PhonemeSet& set) {
+    out << "time,class,silent,jaw";
+    const std::size_t n = result.frames.empty() ? 0 : result.frames[0].features.spectrum.size();
+    for (std::size_t i = 0; i < n; ++i) out << ",f" << i;
+    out << '\n' << std::fixed;
+    for (const auto& f : result.frames) {
+        const auto& l = f.label;
+        out << std::setprecision(3) << l.time << ',' << set[l.phoneme].name << ',' << l.silent
+            << ',' << std::setprecision(4) << l.jaw;
+        for (float v : f.features.spectrum) out << ',' << v;
+        out << '\n';
+    }
+}
+
 void runAnalyze(const AnalyzeOptions& o) {
     const auto templates = o.frontEnd.loadTemplates();
     const auto& set = PhonemeSet::common();
-    const auto result = dsp::analyzeFile(o.input, templates, set, o.frontEnd.config(),
-                                         o.frontEnd.decode(), o.frontEnd.raw(), !o.frames.empty());
+    const auto result =
+        dsp::analyzeFile(o.input, templates, set, o.frontEnd.config(), o.frontEnd.decode(),
+                         o.frontEnd.raw(), !o.frames.empty() || !o.features.empty());
     if (result.nonFiniteSamples > 0)
         std::cerr << "lipsync analyze: warning: " << o.input << ": " << result.nonFiniteSamples
                   << " non-finite samples (NaN/inf) read as silence\n";
@@ -68,7 +86,10 @@ void runAnalyze(const AnalyzeOptions& o) {
         });
     if (!o.frames.empty())
         withOutputStream(o.frames, [&](std::ostream& out) { writeFrames(out, result, set); });
-    if (!o.runtime.weights.empty()) o.runtime.writeWeights(o.runtime.animate(result.schedule, &result.levels));
+    if (!o.features.empty())
+        withOutputStream(o.features, [&](std::ostream& out) { writeFeatures(out, result, set); });
+    if (!o.runtime.weights.empty())
+        o.runtime.writeWeights(o.runtime.animate(result.schedule, &result.levels));
 }
 }  // namespace
 
@@ -84,6 +105,9 @@ void addAnalyzeCommand(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--frames", o->frames,
                     "Also write per-frame energy, voicing, class, runner-up and distances (CSV)");
+    cmd->add_option("--features", o->features,
+                    "Also write each frame's feature vector (LPC spectrum in dB, then the extra "
+                    "features), decided class and heard jaw (CSV, for training experiments)");
     cmd->add_flag("--quiet,-q", o->quiet, "No summary on stderr");
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, true);

@@ -2,6 +2,7 @@
 #include <iomanip>
 #include <iostream>
 #include <lipsyncd/dsp.hpp>
+#include <optional>
 
 #include "Commands.hpp"
 #include "Corpus.hpp"
@@ -17,6 +18,7 @@ struct TrainOptions {
     std::string description;
     std::vector<std::string> extraFeatures{"log_error", "level"};
     bool normaliseChannel = false;
+    std::string keepTemplates;  // train only the jaw network, into this set
 };
 
 // The mean spectrum of the training speech (valid frames within 30 dB of their file's peak):
@@ -45,6 +47,16 @@ std::vector<float> speechSpectrumMean(const TrainOptions& o) {
 }
 
 void runTrain(TrainOptions o) {
+    std::optional<dsp::TemplateSet> kept;
+    if (!o.keepTemplates.empty()) {
+        kept = dsp::TemplateSet::named(o.keepTemplates);
+        o.training.analysis = kept->analysis;  // the network hears frames as the set does
+        o.training.clustersPerClass = 1;       // the clusters are thrown away
+        if (o.training.jawHiddenUnits == 0)
+            throw InputError(
+                "--keep-templates trains only the jaw network: --jaw-hidden 0 "
+                "leaves nothing to train");
+    }
     if (o.normaliseChannel) o.training.analysis.spectrumMean = speechSpectrumMean(o);
     const auto& set = PhonemeSet::common();
     dsp::TemplateTrainer trainer(o.training, set);
@@ -67,6 +79,13 @@ void runTrain(TrainOptions o) {
     auto templates = trainer.build(o.description.empty() ? "trained by 'lipsync train' from " +
                                                                std::to_string(files) + " files"
                                                          : o.description);
+    if (kept) {
+        if (!templates.jawNetwork)
+            throw InputError("--keep-templates: too little labelled speech for the jaw network");
+        kept->jawNetwork = std::move(templates.jawNetwork);
+        if (!o.description.empty()) kept->description = o.description;
+        templates = std::move(*kept);
+    }
     templates.save(o.output);
     std::cerr << "lipsync train: " << files << " files (" << std::fixed << std::setprecision(0)
               << seconds << " s) -> " << templates.classes.size() << " classes in " << o.output
@@ -95,6 +114,14 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_flag("--full-covariance", o->training.fullCovariance,
                   "Match under the pooled within-class covariance of all features (a Mahalanobis "
                   "distance, stored as the set's 'whitening') instead of per-feature weights");
+    cmd->add_option("--jaw-hidden", o->training.jawHiddenUnits,
+                    "Hidden units of the jaw network trained beside the templates (the jaw heard "
+                    "from each frame); 0: none, the jaw comes from the class distances")
+        ->check(CLI::Range(0, 256))
+        ->capture_default_str();
+    cmd->add_option("--jaw-epochs", o->training.jawEpochs, "Passes of the jaw network's training")
+        ->check(CLI::Range(1, 100))
+        ->capture_default_str();
     cmd->add_option("--order", o->training.analysis.order, "LPC order")
         ->check(CLI::Range(2, dsp::kMaxOrder))
         ->capture_default_str();
@@ -113,6 +140,10 @@ void addTrainCommand(CLI::App& app) {
                     "before a voice's own mean takes over")
         ->check(CLI::Range(0.1, 600.0))
         ->capture_default_str();
+    cmd->add_option("--keep-templates", o->keepTemplates,
+                    "Train only the jaw network: write this template set (name or file) with the "
+                    "network trained on the corpus, its analysis, templates and weights unchanged")
+        ->excludes("--normalise-channel");
     cmd->add_option("--description", o->description, "Description stored in the file");
     cmd->callback([o] {
         auto& a = o->training.analysis;

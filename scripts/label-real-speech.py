@@ -126,7 +126,7 @@ def fillets_items(root, lang, voice):
                     items.append((f"{level}_{key}", audio, m.group(1).replace('\\"', '"')))
                 key = None
     for name, audio, text in sorted(items)[:FILLETS_MAX_ITEMS]:
-        yield name, audio, ("espeak", lang, text), None
+        yield name, audio, ("espeak", lang, text), None, text
 
 
 def festvox_ru_items(root):

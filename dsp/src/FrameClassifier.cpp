@@ -21,7 +21,7 @@ constexpr float kInitialNoiseFloorDb = -70.0f;
 
 FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet& set,
                                  const ClassifierConfig& config)
-    : set_(&set), config_(config) {
+    : set_(&set), config_(config), jawNetwork_(templates.jawNetwork) {
     matrix_ = std::make_shared<const TemplateMatrix>(templates, set);
     scaledFrame_.assign(matrix_->features(), 0.0f);
     distances_.assign(set.size(), std::numeric_limits<float>::infinity());
@@ -121,7 +121,7 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
 
     label.silent = !frame.valid || frame.energyDb < gate;
     if (!label.silent) {
-        label.jaw = expectedJaw(label.distance);
+        label.jaw = jawNetwork_ ? (*jawNetwork_)(frame.spectrum) : expectedJaw(label.distance);
         return label;
     }
     label.runnerUp = label.phoneme;

@@ -98,6 +98,29 @@ std::vector<double> precise(const std::vector<float>& v) {
     }
     return out;
 }
+
+JawNetwork readJawNetwork(const json& j, const std::string& source) {
+    const std::string p = "jaw_network.";
+    JawNetwork n;
+    n.inputMean = member<std::vector<float>>(j, "input_mean", p, source);
+    n.inputScale = member<std::vector<float>>(j, "input_scale", p, source);
+    n.hiddenWeights = member<std::vector<std::vector<float>>>(j, "hidden_weights", p, source);
+    n.hiddenBias = member<std::vector<float>>(j, "hidden_bias", p, source);
+    n.outputWeights = member<std::vector<float>>(j, "output_weights", p, source);
+    n.outputBias = member<float>(j, "output_bias", p, source);
+    return n;
+}
+
+json writeJawNetwork(const JawNetwork& n) {
+    json hidden = json::array();
+    for (const auto& row : n.hiddenWeights) hidden.push_back(precise(row));
+    return {{"input_mean", precise(n.inputMean)},
+            {"input_scale", precise(n.inputScale)},
+            {"hidden_weights", hidden},
+            {"hidden_bias", precise(n.hiddenBias)},
+            {"output_weights", precise(n.outputWeights)},
+            {"output_bias", precise({n.outputBias})[0]}};
+}
 }  // namespace
 
 void TemplateSet::validate(const std::string& source) const {
@@ -132,6 +155,7 @@ void TemplateSet::validate(const std::string& source) const {
                                  where + "[" + std::to_string(r) + "]: the diagonal must be > 0");
         }
     }
+    if (jawNetwork) jawNetwork->validate(bins, source);
     if (classes.empty()) throw InputError(source, 0, "no classes");
     const PhonemeSet& set = PhonemeSet::common();
     for (std::size_t c = 0; c < classes.size(); ++c) {
@@ -167,6 +191,8 @@ TemplateSet TemplateSet::load(const std::filesystem::path& file) {
     t.binWeights = member<std::vector<float>>(j, "bin_weights", "", source);
     if (j.contains("whitening"))
         t.whitening = member<std::vector<std::vector<float>>>(j, "whitening", "", source);
+    if (j.contains("jaw_network"))
+        t.jawNetwork = readJawNetwork(member<json>(j, "jaw_network", "", source), source);
     const auto classes = member<json>(j, "classes", "", source);
     if (!classes.is_array()) throw InputError(source, 0, "field 'classes' must be an array");
     for (std::size_t i = 0; i < classes.size(); ++i) {
@@ -209,6 +235,7 @@ void TemplateSet::save(const std::filesystem::path& file) const {
         for (const auto& row : whitening) rows.push_back(precise(row));
         j["whitening"] = rows;
     }
+    if (jawNetwork) j["jaw_network"] = writeJawNetwork(*jawNetwork);
     std::ofstream out(file);
     if (!out) throw InputError(file.string() + ": cannot write");
     out << j.dump(1) << '\n';

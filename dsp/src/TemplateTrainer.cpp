@@ -80,6 +80,7 @@ void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames,
                                    const PhonemeSchedule& labels) {
     float peak = -120;
     for (const auto& f : frames) peak = std::max(peak, f.energyDb);
+    if (options_.jawHiddenUnits > 0) addJawFrames(frames, labels, peak);
     std::size_t seg = 0;
     for (const auto& f : frames) {
         while (seg < labels.size() && labels[seg].end <= f.time) ++seg;
@@ -95,6 +96,32 @@ void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames,
         if (!inside && !middle) continue;
         if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb) continue;
         if (const auto cls = set_->find(label.phoneme)) addFrame(f, *cls);
+    }
+}
+
+// The jaw network learns from every frame of speech, transitions included (the jaw moves
+// through them too), against what `lipsync eval` scores a jaw on: each frame's phoneme jaw
+// height, averaged over the frames within 20 ms (lipsync::JawScoreConfig::smoothingSeconds).
+void TemplateTrainer::addJawFrames(std::span<const FrameFeatures> frames,
+                                   const PhonemeSchedule& labels, float peak) {
+    std::vector<float> height(frames.size(), 0.0f);
+    std::size_t seg = 0;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        while (seg < labels.size() && labels[seg].end <= frames[i].time) ++seg;
+        if (seg >= labels.size() || frames[i].time < labels[seg].start) continue;  // silence
+        const auto cls = set_->find(labels[seg].phoneme);
+        if (!cls || !(*set_)[*cls].jaw) return;  // a set without jaw heights: nothing to learn
+        height[i] = *(*set_)[*cls].jaw;
+    }
+    const auto half = static_cast<std::size_t>(std::lround(0.02 / options_.analysis.hopSeconds));
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        const auto& f = frames[i];
+        if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb) continue;
+        const std::size_t lo = i > half ? i - half : 0, hi = std::min(frames.size(), i + half + 1);
+        float sum = 0;
+        for (std::size_t k = lo; k < hi; ++k) sum += height[k];
+        jawTargets_.push_back(sum / static_cast<float>(hi - lo));
+        jawInputs_.insert(jawInputs_.end(), f.spectrum.begin(), f.spectrum.end());
     }
 }
 
@@ -157,6 +184,12 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
     double inverseSum = 0;
     for (std::size_t b = 0; b < bins; ++b) inverseSum += 1.0 / covariance[b * bins + b];
     t.binWeights.resize(bins);
+    // Enough speech for the network to learn more than one voice's quirks: else none, and the
+    // jaw comes from the class distances.
+    constexpr std::size_t kMinJawFrames = 2000;
+    if (options_.jawHiddenUnits > 0 && jawTargets_.size() >= kMinJawFrames)
+        t.jawNetwork = trainJawNetwork(jawInputs_, jawTargets_, bins, options_.jawHiddenUnits,
+                                       options_.jawEpochs, options_.seed);
     if (options_.fullCovariance) {
         // Scaled so that a frame's expected distance to its own class's mean is what the
         // per-bin weights give (the harmonic mean of the variances, in dB²): the decoder's and
