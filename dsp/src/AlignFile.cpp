@@ -161,6 +161,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
         aligner.push(f.label.time, analyzer.distances(), f.label.silent);
         speechFrames += !f.label.silent;
         r.levels.add(f.label.time, f.label.energyDb);
+        r.levels.jaw.push_back(f.label.jaw);  // the heard jaw, at the aligned share
     });
     analyzer.onSegment([&](const PhonemeSegment& s) { r.audioOnly.push_back(s); });
     std::vector<float> block(kReadBlock);
@@ -195,6 +196,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
         return r;
     }
     warnAboutWords(r);
+    r.levels.aligned = true;  // (an audio-only fallback keeps the audio-only share)
     r.schedule = r.alignment.schedule;
     // Before the first frame and after the last, nothing was heard: silence, not a phoneme.
     if (!r.schedule.empty()) {

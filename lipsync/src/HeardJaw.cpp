@@ -24,16 +24,16 @@ double heardAt(const LevelTrack& levels, double t, double half) {
 }
 }  // namespace
 
-void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights) {
+void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights, bool aligned) {
     heard = std::isfinite(heard) ? std::clamp(heard, 0.0, 1.0) : 0.0;
     for (std::size_t p = 0; p < poses.size(); ++p) {
         const auto& pose = poses.poses()[p];
-        if (pose.heardJaw <= 0) continue;
+        const double g = aligned ? pose.heardJawAligned : pose.heardJaw;
+        if (g <= 0) continue;
         // Where the schedule closes the lips, the heard height gives way: a bilabial the
         // schedule places stays a closure.
         const auto closer = poses.find(pose.heardJawClosedBy);
         const double closed = closer ? std::clamp<double>(weights[*closer], 0.0, 1.0) : 0.0;
-        const double g = pose.heardJaw;
         weights[p] = static_cast<float>((1 - g) * weights[p] + g * heard * (1 - closed));
     }
 }
@@ -43,7 +43,8 @@ void blendHeardJaw(const PoseSet& poses, const LevelTrack& levels, PoseTrack& tr
     if (levels.jaw.empty() || track.poses.size() != poses.size()) return;
     for (std::size_t f = 0; f < track.frames(); ++f)
         blendHeardJaw(poses, heardAt(levels, track.times[f], smoothingSeconds / 2),
-                      std::span<float>(track.values).subspan(f * poses.size(), poses.size()));
+                      std::span<float>(track.values).subspan(f * poses.size(), poses.size()),
+                      levels.aligned);
 }
 
 }  // namespace lipsyncd::lipsync

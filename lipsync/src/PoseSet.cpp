@@ -99,6 +99,9 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
             t.fail("loudness_gain", "must be in [0, 1]");
         p.heardJaw = t.optNumber("heard_jaw").value_or(0);
         if (!(p.heardJaw >= 0 && p.heardJaw <= 1)) t.fail("heard_jaw", "must be in [0, 1]");
+        p.heardJawAligned = t.optNumber("heard_jaw_aligned").value_or(0);
+        if (!(p.heardJawAligned >= 0 && p.heardJawAligned <= 1))
+            t.fail("heard_jaw_aligned", "must be in [0, 1]");
         p.heardJawClosedBy = t.optString("heard_jaw_closed_by").value_or("");
         t.finish();
         poses.push_back(std::move(p));

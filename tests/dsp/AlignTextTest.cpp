@@ -3,6 +3,7 @@
 // clear error or a flagged audio-only fallback.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <lipsyncd/dsp.hpp>
@@ -79,6 +80,11 @@ TEST(AlignText, EspeakSpeechBoundariesMatchItsOwnTimings) {
     for (std::size_t i = 1; i < r.schedule.size(); ++i)
         EXPECT_NEAR(r.schedule[i].start, r.schedule[i - 1].end, 1e-9);
     EXPECT_NEAR(r.schedule.back().end, r.durationSeconds, 1e-9);
+    // The jaw heard in every frame travels with the levels, marked as aligned speech's (the
+    // pose set's heard_jaw_aligned share).
+    EXPECT_TRUE(r.levels.aligned);
+    ASSERT_EQ(r.levels.jaw.size(), r.levels.db.size());
+    EXPECT_GT(*std::max_element(r.levels.jaw.begin(), r.levels.jaw.end()), 0.5f);
 }
 
 TEST(AlignText, WordsTheSpeakerSkippedAreNotPlacedAndSaid) {
@@ -197,6 +203,7 @@ TEST(AlignText, AudioFarShorterThanTheWordsFallsBackWithAWarning) {
     for (const auto& w : r.warnings) said |= w.find("far shorter") != std::string::npos;
     EXPECT_TRUE(said);
     EXPECT_FALSE(r.schedule.empty());
+    EXPECT_FALSE(r.levels.aligned);  // audio-only analysis: the audio-only share of the jaw
 }
 
 // The service's path: a FILE.txt beside FILE.wav is used, and said so; without one, or with

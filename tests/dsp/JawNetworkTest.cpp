@@ -173,7 +173,10 @@ TEST(JawNetwork, TravelsWithTheTemplatesAndIsValidated) {
     rejects(bad, "jaw_network.input_mean has 3 values, expected 4");
     bad = t;
     bad.jawNetwork->hiddenWeights[2].push_back(1);
-    rejects(bad, "jaw_network.hidden_weights[2] has 5 values");
+    rejects(bad, "jaw_network.hidden_weights[2] has 9 values, expected 8");
+    bad = t;
+    bad.jawNetwork->hiddenWeights.pop_back();
+    rejects(bad, "jaw_network.hidden_weights has 3 values, expected 4");
     bad = t;
     bad.jawNetwork->outputWeights.pop_back();
     rejects(bad, "jaw_network.output_weights has 7 values, expected 8");

@@ -12,14 +12,17 @@ namespace lipsyncd::test {
 namespace {
 
 std::filesystem::path poseFile(const std::string& body) {
-    const auto file = std::filesystem::temp_directory_path() / "lipsyncd-heard-jaw-poses.toml";
+    // One file per test: ctest runs the tests as separate processes, side by side.
+    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    const auto file = std::filesystem::temp_directory_path() /
+                      ("lipsyncd-heard-jaw-" + std::string(test->name()) + ".toml");
     std::ofstream(file) << "name = \"heard\"\n" << body;
     return file;
 }
 
 lipsync::PoseSet jawAndLips() {
     return lipsync::PoseSet::load(
-        poseFile("[[pose]]\nname = \"jaw\"\nheard_jaw = 0.8\n"
+        poseFile("[[pose]]\nname = \"jaw\"\nheard_jaw = 0.8\nheard_jaw_aligned = 0.4\n"
                  "heard_jaw_closed_by = \"pbm\"\n"
                  "[[pose]]\nname = \"pbm\"\n"));
 }
@@ -54,6 +57,20 @@ TEST(HeardJaw, SetsItsShareOfTheJawAndLeavesTheLipsAlone) {
     EXPECT_FLOAT_EQ(t.frame(1)[1], 0.3f);
 }
 
+TEST(HeardJaw, SpeechAlignedOnItsWordsTakesTheAlignedShare) {
+    const auto poses = jawAndLips();
+    auto analysed = track({{0.5f, 0.0f}}), aligned = analysed;
+    auto levels = heardThroughout(1.0f, 30);
+    lipsync::blendHeardJaw(poses, levels, analysed);
+    levels.aligned = true;  // the schedule's phonemes were aligned on known words: surer
+    lipsync::blendHeardJaw(poses, levels, aligned);
+    EXPECT_NEAR(analysed.frame(0)[0], 0.2 * 0.5 + 0.8 * 1.0, 1e-5);
+    EXPECT_NEAR(aligned.frame(0)[0], 0.6 * 0.5 + 0.4 * 1.0, 1e-5);
+    std::vector<float> live = {0.5f, 0.0f};
+    lipsync::blendHeardJaw(poses, 1.0, live, true);
+    EXPECT_NEAR(live[0], 0.7f, 1e-6f);
+}
+
 TEST(HeardJaw, AClosureTheSchedulePlacesStaysClosed) {
     const auto poses = jawAndLips();
     auto t = track({{0.0f, 1.0f}});
@@ -85,6 +102,7 @@ TEST(HeardJaw, OneFrameOfALiveStreamBlendsAsTheOfflineTrackDoes) {
 
 TEST(HeardJaw, APoseSetRejectsABadShareOrAnUnknownClosingPose) {
     for (const std::string body : {"[[pose]]\nname = \"jaw\"\nheard_jaw = 1.5\n",
+                                   "[[pose]]\nname = \"jaw\"\nheard_jaw_aligned = -0.1\n",
                                    "[[pose]]\nname = \"jaw\"\nheard_jaw_closed_by = \"lips\"\n"}) {
         const auto file = poseFile(body);
         try {

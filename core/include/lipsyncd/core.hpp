@@ -173,6 +173,10 @@ struct LevelTrack {
     // class scores point to (dsp FrameLabel::jaw), which the runtime can blend into the jaw
     // pose (lipsync::blendHeardJaw). Empty otherwise (speech whose phonemes are known).
     std::vector<float> jaw;
+    // The schedule beside this track was aligned on known words (dsp alignText): its phonemes
+    // are surer than audio-only analysis's, so the heard jaw takes the smaller share a pose set
+    // gives aligned speech (heard_jaw_aligned).
+    bool aligned = false;
     // The level at time t (nearest frame; the first/last frame outside the track).
     float at(double t) const;
     // Appends the next frame's level; the first frame's time sets `start`.

@@ -232,7 +232,7 @@ class FrameAnalyzer {
 // the frames of one jaw height share, where nearest templates follow one voice's spectrum.
 struct JawNetwork {
     std::vector<float> inputMean, inputScale;       // per feature: x' = (x − mean) · scale
-    std::vector<std::vector<float>> hiddenWeights;  // per hidden unit: one weight per feature
+    std::vector<std::vector<float>> hiddenWeights;  // per feature: its weight to each unit
     std::vector<float> hiddenBias;                  // per hidden unit
     std::vector<float> outputWeights;               // per hidden unit
     float outputBias = 0;
@@ -769,7 +769,8 @@ class ForcedAligner {
 struct AlignFileResult {
     PhonemeSchedule schedule;   // aligned where words were placed, audio-only elsewhere
     PhonemeSchedule audioOnly;  // the front end's own schedule (analyzeFile)
-    LevelTrack levels;          // every frame's RMS level (dBFS): how wide the mouth opens
+    LevelTrack
+        levels;  // every frame: its RMS level (dBFS) and the jaw heard; aligned unless fellBack
     Alignment alignment;
     double durationSeconds = 0, timeScale = 1;
     std::vector<std::string> warnings;  // unplaced words, fallbacks: for the user

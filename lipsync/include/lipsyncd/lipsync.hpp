@@ -39,8 +39,10 @@ struct Pose {
     double smoothingWindow = 0.18;  // 2·t_w, seconds (section 2.2.1)
     // How much of the pose's weight speech loudness controls (shapeByLoudness): 0 none, 1 all.
     double loudnessGain = 0;
-    // How much of the weight the jaw heard in the audio sets (blendHeardJaw): 0 none, 1 all.
+    // How much of the weight the jaw heard in the audio sets (blendHeardJaw): 0 none, 1 all;
+    // for speech aligned on its words (LevelTrack::aligned), heardJawAligned.
     double heardJaw = 0;
+    double heardJawAligned = 0;
     // A pose (the lips' closure) whose weight w holds the heard jaw back to (1 − w) of its share:
     // a closure the schedule places stays closed. Empty: none.
     std::string heardJawClosedBy;
@@ -236,14 +238,16 @@ void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels, PoseTrack& 
                      const LoudnessConfig& config = {});
 // The jaw the front end heard (LevelTrack::jaw: per frame, the jaw height its class scores point
 // to, smoothed over `smoothingSeconds`) blended into each pose with a heard_jaw share g:
-// w' = (1 − g)·w + g·heard. Nothing where the track has no jaw (known phonemes).
+// w' = (1 − g)·w + g·heard (g: heard_jaw, or heard_jaw_aligned for a track of aligned speech).
+// Nothing where the track has no jaw (phonemes known exactly: say).
 // The window the heard jaw is averaged over, offline and in the live stream alike.
 inline constexpr double kHeardJawSmoothingSeconds = 0.04;
 void blendHeardJaw(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
                    double smoothingSeconds = kHeardJawSmoothingSeconds);
 // One frame of weights (poses in pose-set order) and the jaw heard around its time: what the
 // offline blend does per frame, for a live stream (the service's live mode).
-void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights);
+void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights,
+                   bool aligned = false);
 
 // Streaming: L is a decaying peak of the levels seen so far; frames are shaped as they leave.
 class LoudnessShaper {
