@@ -51,7 +51,8 @@ void runTrain(TrainOptions o) {
     if (!o.keepTemplates.empty()) {
         kept = dsp::TemplateSet::named(o.keepTemplates);
         o.training.analysis = kept->analysis;  // the network hears frames as the set does
-        o.training.clustersPerClass = 1;       // the clusters are thrown away
+        o.training.clustersPerClass = 1;       // the clusters are thrown away ...
+        o.training.minFramesPerCluster = 1;    // ... and need no minimum
         if (o.training.jawHiddenUnits == 0)
             throw InputError(
                 "--keep-templates trains only the jaw network: --jaw-hidden 0 "

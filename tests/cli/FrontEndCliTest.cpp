@@ -90,6 +90,33 @@ TEST(LipsyncCli, AnalyzeWritesAScheduleThatReadsBack) {
     EXPECT_NE(header.find("runner_up"), std::string::npos) << header;
 }
 
+// --features: every frame's feature vector, as the templates and the jaw network see it, with
+// the class decided and the heard jaw (what a training experiment starts from).
+TEST(LipsyncCli, AnalyzeWritesEachFramesFeatures) {
+    const auto out = scratchDir("cli_features") / "features.csv";
+    const auto r = runLipsync(
+        {"analyze", exampleWav().string(), "-s", "/dev/null", "--features", out.string(), "-q"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::ifstream csv(out);
+    std::string line;
+    std::getline(csv, line);
+    const auto features = dsp::TemplateSet::loadDefault().analysis.featureCount();
+    EXPECT_EQ(line.rfind("time,class,silent,jaw,f0,", 0), 0u) << line;
+    EXPECT_NE(line.find(",f" + std::to_string(features - 1)), std::string::npos) << line;
+    std::size_t rows = 0, open = 0;
+    while (std::getline(csv, line)) {
+        ++rows;
+        EXPECT_EQ(std::count(line.begin(), line.end(), ','), 3 + features) << line;
+        const auto jaw =
+            std::stod(line.substr(line.find(',', line.find(',', line.find(',') + 1) + 1) + 1));
+        EXPECT_GE(jaw, 0.0);
+        EXPECT_LE(jaw, 1.0);
+        open += jaw > 0.5;
+    }
+    EXPECT_GT(rows, 100u);  // 10 ms frames of a second and more of speech
+    EXPECT_GT(open, 5u) << "'open wide' opens the heard jaw";
+}
+
 TEST(LipsyncCli, AnalyzeReadsRawPcmFromStdin) {
     const auto raw = scratchDir("cli_raw") / "hello.f32";
     {
@@ -218,6 +245,52 @@ TEST(LipsyncCli, CalibrateFromReadSpeechReplacesTheClassesItHeard) {
     EXPECT_NE(spectraOf(own, "bmp"), spectraOf(base, "bmp")) << "b, m, p were heard: replaced";
     EXPECT_NE(spectraOf(own, "ih"), spectraOf(base, "ih"));
     EXPECT_EQ(spectraOf(own, "oy"), spectraOf(base, "oy")) << "no oy in these lines: kept";
+    // Half a minute of one voice trains no jaw network: the base set's stays.
+    ASSERT_TRUE(own.jawNetwork && base.jawNetwork);
+    EXPECT_EQ(own.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
+}
+
+// train --keep-templates: only the jaw network is trained, on the labelled speech given; the
+// set's analysis, templates and weights are written back as they were. Too little speech for a
+// network is an error, not a set without one.
+TEST(LipsyncCli, TrainKeepTemplatesAddsOnlyTheJawNetwork) {
+    const auto dir = scratchDir("cli_train_jaw");
+    const char* lines[] = {"Hello puppet, open wide and sing to me.",
+                           "Bob bought a big bag of beans by the bay.",
+                           "Why do you sit so still when the show is on?",
+                           "A large black cat sat on the warm mat at home.",
+                           "Father saw the old car far down the long road.",
+                           "We will meet again when the moon is high."};
+    for (int i = 0; i < 6; ++i)
+        for (const char* voice : {"en-us", "en-gb+f2", "en-us+m3"}) {
+            const auto name = dir / ("s" + std::to_string(i) + "-" + voice);
+            ASSERT_EQ(runLipsync({"say", lines[i], "--voice", voice, "--wav",
+                                  name.string() + ".wav", "--schedule", name.string() + ".lab"})
+                          .exitCode,
+                      0);
+        }
+    const auto out = dir.parent_path() / "with-jaw.json";
+    auto r = runLipsync({"train", dir.string(), "--keep-templates", "default", "--jaw-hidden", "8",
+                         "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto set = dsp::TemplateSet::load(out);
+    const auto base = dsp::TemplateSet::loadDefault();
+    ASSERT_TRUE(set.jawNetwork.has_value());
+    EXPECT_EQ(set.jawNetwork->hiddenUnits(), 8u);
+    ASSERT_EQ(set.classes.size(), base.classes.size());
+    for (std::size_t c = 0; c < set.classes.size(); ++c)
+        for (std::size_t k = 0; k < set.classes[c].spectra.size(); ++k)
+            for (std::size_t b = 0; b < set.classes[c].spectra[k].size(); ++b)
+                ASSERT_NEAR(set.classes[c].spectra[k][b], base.classes[c].spectra[k][b], 1e-3);
+    EXPECT_EQ(set.analysis.featureCount(), base.analysis.featureCount());
+
+    fs::create_directories(dir / "one");
+    fs::copy_file(dir / "s0-en-us.wav", dir / "one/s0.wav", fs::copy_options::overwrite_existing);
+    fs::copy_file(dir / "s0-en-us.lab", dir / "one/s0.lab", fs::copy_options::overwrite_existing);
+    r = runLipsync(
+        {"train", (dir / "one").string(), "--keep-templates", "default", "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("too little labelled speech"), std::string::npos) << r.err;
 }
 
 }  // namespace
