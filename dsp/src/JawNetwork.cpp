@@ -18,7 +18,7 @@ constexpr std::size_t kMaxFeatures = 520;
 constexpr std::size_t kMaxHiddenUnits = 256;
 
 // Rectified linear units: as good as tanh on the real dev speakers (frame jaw r 0.86 / 0.75 /
-// 0.75 against 0.86 / 0.74 / 0.73) and no transcendental function per unit in the frame loop.
+// 0.75 against 0.85 / 0.75 / 0.74) and no transcendental function per unit in the frame loop.
 float rectify(float a) {
     return a > 0 ? a : 0.0f;
 }
@@ -58,9 +58,7 @@ void requireSize(std::size_t size, std::size_t expected, const std::string& fiel
                          "jaw_network." + field + " has " + std::to_string(size) +
                              " values, expected " + std::to_string(expected));
 }
-}  // namespace
 
-namespace {
 // The hidden units' sums, feature by feature: one feature's weights to every unit lie side by
 // side, so the inner loop vectorises without reordering any sum.
 LIPSYNCD_VECTOR_CLONES void hiddenSums(const JawNetwork& net, std::span<const float> features,

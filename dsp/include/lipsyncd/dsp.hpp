@@ -599,10 +599,10 @@ struct TrainingOptions {
     // several at once), which a per-bin weight counts again for every bin it touches.
     bool fullCovariance = false;
     // The jaw network (TemplateSet::jawNetwork) trained beside the templates: hidden units (0:
-    // none) and passes over the frames. Real dev speakers, frame by frame (jaw r against the
-    // labels' jaw heights): 0.83 / 0.72 / 0.68 from the class distances, 0.85 / 0.74 / 0.73 with
-    // 32 units after 4 passes; more context (the frames 20–60 ms before) fitted espeak-ng better
-    // and real voices worse.
+    // none) and passes over the frames. Real dev speakers (klettres-en / ktuberling-en /
+    // festvox-ru), frame by frame, jaw r against the labels' jaw heights: 0.83 / 0.72 / 0.68
+    // from the class distances, 0.86 / 0.75 / 0.75 with 32 units after 4 passes; more context
+    // (the frames 20–60 ms before) fitted espeak-ng better and real voices worse.
     int jawHiddenUnits = 32;
     int jawEpochs = 4;
 };
