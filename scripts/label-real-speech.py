@@ -266,7 +266,10 @@ def write_text(path, text):
 
 
 def convert(src, dst):
-    subprocess.run(["sox", "-q", str(src), "-r", "16000", "-c", "1", "-b", "16", str(dst)],
+    # -R: sox dithers with a fixed seed, so the same package gives the same WAV (and the same
+    # labels) on every run; without it the dither differs, and pocketsphinx places a few
+    # marginal files on one run and not on the next.
+    subprocess.run(["sox", "-R", "-q", str(src), "-r", "16000", "-c", "1", "-b", "16", str(dst)],
                    check=True)
     info = subprocess.run(["soxi", "-D", str(dst)], capture_output=True, text=True, check=True)
     return float(info.stdout)
