@@ -225,7 +225,7 @@ class FrameAnalyzer {
 // Templates and classification.
 
 // How far the jaw opens, heard from one frame's features (the same vector the templates are
-// matched on): a network with one hidden layer of tanh units and a logistic output, trained on
+// matched on): a network with one hidden layer of rectified units and a logistic output, trained on
 // labelled speech against the jaw heights of the frames' phoneme classes (TemplateTrainer). A
 // multilayer perceptron estimates from the acoustic features directly what a classifier would
 // pass through a class decision (Bourlard & Morgan 1994); trained on many voices it pools what
@@ -769,8 +769,8 @@ class ForcedAligner {
 struct AlignFileResult {
     PhonemeSchedule schedule;   // aligned where words were placed, audio-only elsewhere
     PhonemeSchedule audioOnly;  // the front end's own schedule (analyzeFile)
-    LevelTrack
-        levels;  // every frame: its RMS level (dBFS) and the jaw heard; aligned unless fellBack
+    // Every frame: its RMS level (dBFS) and the jaw heard; aligned unless fellBack.
+    LevelTrack levels;
     Alignment alignment;
     double durationSeconds = 0, timeScale = 1;
     std::vector<std::string> warnings;  // unplaced words, fallbacks: for the user
