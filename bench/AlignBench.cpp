@@ -49,7 +49,7 @@ const Material& material() {
         dsp::StreamingAnalyzer analyzer(templates, PhonemeSet::common(), out.rate);
         analyzer.onFrame([&](const dsp::StreamingAnalyzer::Frame& f) {
             out.times.push_back(f.label.time);
-            const auto d = analyzer.distances();
+            const auto d = analyzer.templateDistances();
             out.distances.emplace_back(d.begin(), d.end());
             out.silent.push_back(f.label.silent);
         });

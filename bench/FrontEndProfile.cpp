@@ -120,6 +120,7 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
         Levinson,
         Spectrum,
         Classify,
+        Classes,
         Jaw,
         Viterbi,
         Segment
@@ -127,7 +128,8 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     StageClock clock({"decode (libsndfile, to mono)", "resample to 10 kHz (libsoxr)",
                       "level (RMS, clipping)", "pre-emphasis and window", "autocorrelation",
                       "Levinson-Durbin", "LPC spectrum", "template distances",
-                      "jaw network (heard jaw)", "Viterbi decoder (fixed lag)", "segmenter"});
+                      "class network (likelihoods)", "jaw network (heard jaw)",
+                      "Viterbi decoder (fixed lag)", "segmenter"});
 
     // Decode and resample the whole file in the blocks analyzeFile uses.
     auto decoder = dsp::AudioDecoder::open(file);
@@ -165,10 +167,20 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     std::vector<dsp::FrameFeatures> features(kBlock, analyzer.makeFeatures());
     dsp::DirectLpcSpectrum spectrum(c.order, c.spectrumBins);
     const auto bins = static_cast<std::size_t>(c.spectrumBins);
-    // The distances alone here; the jaw network (which classify() runs when the set has one)
-    // is its own stage.
+    // The distances alone here; the networks (which classify() runs when the set has them)
+    // are stages of their own.
     auto distancesOnly = templates;
     distancesOnly.jawNetwork.reset();
+    distancesOnly.classNetwork.reset();
+    const float classNetworkDb = dsp::ClassifierConfig{}.classNetworkDb;
+    std::vector<int> networkClass;
+    std::vector<float> likelihoods, scratch;
+    if (templates.classNetwork) {
+        for (const auto& name : templates.classNetwork->classes)
+            networkClass.push_back(static_cast<int>(*set.find(name)));
+        likelihoods.resize(networkClass.size());
+        scratch.resize(templates.classNetwork->hiddenUnits());
+    }
     dsp::FrameClassifier classifier(distancesOnly, set);
     float jawSum = 0;  // kept, so the network's work is not optimised away
     std::vector<dsp::FrameLabel> labels(kBlock);
@@ -227,6 +239,17 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
                 distances[k].assign(classifier.distances().begin(), classifier.distances().end());
             }
         });
+        if (templates.classNetwork)
+            clock.time(Classes, [&] {
+                for (std::size_t k = 0; k < count; ++k) {
+                    if (!features[k].valid) continue;
+                    templates.classNetwork->scaledLogLikelihoods(features[k].spectrum, likelihoods,
+                                                                 scratch);
+                    const float best = *std::max_element(likelihoods.begin(), likelihoods.end());
+                    for (std::size_t o = 0; o < likelihoods.size(); ++o)
+                        distances[k][networkClass[o]] += classNetworkDb * (best - likelihoods[o]);
+                }
+            });
         if (templates.jawNetwork)
             clock.time(Jaw, [&] {
                 for (std::size_t k = 0; k < count; ++k)

@@ -71,7 +71,9 @@ void runCalibrate(const CalibrateOptions& o) {
     training.analysis = base.analysis;
     training.clustersPerClass = o.clusters;
     training.minFramesPerCluster = 10;  // a second of held sound is plenty for one speaker
-    training.jawHiddenUnits = 0;  // half a minute of one voice is too little: the base's stays
+    // Half a minute of one voice is too little for a network: the base's stay.
+    training.jawHiddenUnits = 0;
+    training.classHiddenUnits = 0;
     dsp::TemplateTrainer trainer(training, set);
     if (!std::filesystem::is_directory(o.folder)) throw InputError(o.folder + ": not a folder");
     std::vector<std::string> recorded;

@@ -52,6 +52,12 @@ struct FrontEndOptions {
                        "still count towards the jaw height heard in a frame")
             ->check(CLI::Range(0.01, 20.0))
             ->capture_default_str();
+        cmd.add_option("--class-network-db", classifier.classNetworkDb,
+                       "With a template set that has a class network: dB of distance added per "
+                       "nat a class's likelihood lies below the likeliest class's (0: the "
+                       "templates alone)")
+            ->check(CLI::Range(0.0, 20.0))
+            ->capture_default_str();
         addDecoderTo(cmd);
     }
 

@@ -18,7 +18,7 @@ struct TrainOptions {
     std::string description;
     std::vector<std::string> extraFeatures{"log_error", "level"};
     bool normaliseChannel = false;
-    std::string keepTemplates;  // train only the jaw network, into this set
+    std::string keepTemplates;  // train only the networks, into this set
 };
 
 // The mean spectrum of the training speech (valid frames within 30 dB of their file's peak):
@@ -53,10 +53,10 @@ void runTrain(TrainOptions o) {
         o.training.analysis = kept->analysis;  // the network hears frames as the set does
         o.training.clustersPerClass = 1;       // the clusters are thrown away ...
         o.training.minFramesPerCluster = 1;    // ... and need no minimum
-        if (o.training.jawHiddenUnits == 0)
+        if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
             throw InputError(
-                "--keep-templates trains only the jaw network: --jaw-hidden 0 "
-                "leaves nothing to train");
+                "--keep-templates trains only the networks: --jaw-hidden 0 without "
+                "--class-hidden leaves nothing to train");
     }
     if (o.normaliseChannel) o.training.analysis.spectrumMean = speechSpectrumMean(o);
     const auto& set = PhonemeSet::common();
@@ -80,10 +80,13 @@ void runTrain(TrainOptions o) {
     auto templates = trainer.build(o.description.empty() ? "trained by 'lipsync train' from " +
                                                                std::to_string(files) + " files"
                                                          : o.description);
-    if (kept) {
-        if (!templates.jawNetwork)
+    if (kept) {  // each network asked for replaces the set's own; the others stay
+        if (o.training.jawHiddenUnits > 0 && !templates.jawNetwork)
             throw InputError("--keep-templates: too little labelled speech for the jaw network");
-        kept->jawNetwork = std::move(templates.jawNetwork);
+        if (o.training.classHiddenUnits > 0 && !templates.classNetwork)
+            throw InputError("--keep-templates: too little labelled speech for the class network");
+        if (o.training.jawHiddenUnits > 0) kept->jawNetwork = std::move(templates.jawNetwork);
+        if (o.training.classHiddenUnits > 0) kept->classNetwork = std::move(templates.classNetwork);
         if (!o.description.empty()) kept->description = o.description;
         templates = std::move(*kept);
     }
@@ -123,6 +126,15 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_option("--jaw-epochs", o->training.jawEpochs, "Passes of the jaw network's training")
         ->check(CLI::Range(1, 100))
         ->capture_default_str();
+    cmd->add_option("--class-hidden", o->training.classHiddenUnits,
+                    "Hidden units of the class network trained beside the templates (scaled "
+                    "class likelihoods added to the template distances); 0: none")
+        ->check(CLI::Range(0, 256))
+        ->capture_default_str();
+    cmd->add_option("--class-epochs", o->training.classEpochs,
+                    "Passes of the class network's training")
+        ->check(CLI::Range(1, 100))
+        ->capture_default_str();
     cmd->add_option("--order", o->training.analysis.order, "LPC order")
         ->check(CLI::Range(2, dsp::kMaxOrder))
         ->capture_default_str();
@@ -142,8 +154,10 @@ void addTrainCommand(CLI::App& app) {
         ->check(CLI::Range(0.1, 600.0))
         ->capture_default_str();
     cmd->add_option("--keep-templates", o->keepTemplates,
-                    "Train only the jaw network: write this template set (name or file) with the "
-                    "network trained on the corpus, its analysis, templates and weights unchanged")
+                    "Train only the networks (the jaw network, and the class network with "
+                    "--class-hidden; --jaw-hidden 0 keeps the set's jaw network): write this "
+                    "template set (name or file) with them, its analysis, templates and weights "
+                    "unchanged")
         ->excludes("--normalise-channel");
     cmd->add_option("--description", o->description, "Description stored in the file");
     cmd->callback([o] {

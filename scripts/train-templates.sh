@@ -7,11 +7,13 @@
 # corpus (held-out sentences and voices) nor any real dev speaker is used here; they are for
 # `lipsync eval`.
 #
-#   scripts/train-templates.sh             # templates, then the jaw network beside them
-#   scripts/train-templates.sh --jaw-only  # keep the shipped templates, retrain the jaw network
+#   scripts/train-templates.sh                  # templates, then the networks beside them
+#   scripts/train-templates.sh --networks-only  # keep the shipped templates, retrain the networks
 #
-# The jaw network (the jaw heard from each frame: config/templates/README.md) is trained on the
-# same speech, with `lipsync train --keep-templates`, which leaves the templates as they are.
+# The networks (the jaw and the class heard from each frame: config/templates/README.md) are
+# trained on the same speech, with `lipsync train --keep-templates`, which leaves the templates
+# as they are.
+case "${1:-}" in ''|--networks-only) ;; *) echo "usage: scripts/train-templates.sh [--networks-only]" >&2; exit 2 ;; esac
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 lipsync="${LIPSYNC:-$here/build/cli/lipsync}"
@@ -35,13 +37,15 @@ done <"$here/config/corpus/real-speakers.txt"
 # 67.6 % on the espeak-ng dev corpus and the worst real dev speaker stayed within a point.
 out="$here/config/templates/default.json"
 about="espeak-ng $(espeak-ng --version | awk '{print $4}') speech (12 voices and variants, 40 sentences) and real speakers ${speakers[*]}"
-if [ "${1:-}" != --jaw-only ]; then
-  "$lipsync" train "${folders[@]}" --clusters 24 --jaw-hidden 0 -o "$out" \
+if [ "${1:-}" != --networks-only ]; then
+  "$lipsync" train "${folders[@]}" --clusters 24 --jaw-hidden 0 --class-hidden 0 -o "$out" \
     --description "Default templates: trained by scripts/train-templates.sh on $about (24 clusters a class)"
 fi
-# 32 hidden units, 4 passes: 64 units and 8 passes did no better on the real training speakers
-# each left out of their own set (asterisk-en-allison jaw r 0.56 / 0.55, klettres-en-gb 0.78 /
-# 0.78 through jaw-servo).
+# Both networks 32 hidden units, 4 passes: more units or passes did no better on the real
+# training speakers each left out of their own set (jaw network, 64 units and 8 passes:
+# asterisk-en-allison jaw r 0.56 / 0.55, klettres-en-gb 0.78 / 0.78 through jaw-servo; class
+# network: lipsyncd::dsp::TrainingOptions).
 description="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["description"].split(" + jaw network")[0])' "$out")"
-"$lipsync" train "${folders[@]}" --keep-templates "$out" --jaw-hidden 32 --jaw-epochs 4 -o "$out" \
-  --description "$description + jaw network (32 units) on the same speech"
+"$lipsync" train "${folders[@]}" --keep-templates "$out" --jaw-hidden 32 --jaw-epochs 4 \
+  --class-hidden 32 --class-epochs 4 -o "$out" \
+  --description "$description + jaw network and class network (32 units each) on the same speech"

@@ -158,7 +158,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     ForcedAligner aligner(script, set, templates.analysis.hopSeconds, r.timeScale, alignerConfig);
     std::size_t speechFrames = 0;
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
-        aligner.push(f.label.time, analyzer.distances(), f.label.silent);
+        aligner.push(f.label.time, analyzer.templateDistances(), f.label.silent);
         speechFrames += !f.label.silent;
         r.levels.add(f.label.time, f.label.energyDb);
         r.levels.jaw.push_back(f.label.jaw);  // the heard jaw, at the aligned share

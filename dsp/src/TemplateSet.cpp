@@ -1,4 +1,5 @@
 // Spectral templates as data: JSON under config/templates/ (format in its README.md).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -121,6 +122,34 @@ json writeJawNetwork(const JawNetwork& n) {
             {"output_weights", precise(n.outputWeights)},
             {"output_bias", precise({n.outputBias})[0]}};
 }
+
+ClassNetwork readClassNetwork(const json& j, const std::string& source) {
+    const std::string p = "class_network.";
+    ClassNetwork n;
+    n.classes = member<std::vector<std::string>>(j, "classes", p, source);
+    n.inputMean = member<std::vector<float>>(j, "input_mean", p, source);
+    n.inputScale = member<std::vector<float>>(j, "input_scale", p, source);
+    n.hiddenWeights = member<std::vector<std::vector<float>>>(j, "hidden_weights", p, source);
+    n.hiddenBias = member<std::vector<float>>(j, "hidden_bias", p, source);
+    n.outputWeights = member<std::vector<std::vector<float>>>(j, "output_weights", p, source);
+    n.outputBias = member<std::vector<float>>(j, "output_bias", p, source);
+    n.logPrior = member<std::vector<float>>(j, "log_prior", p, source);
+    return n;
+}
+
+json writeClassNetwork(const ClassNetwork& n) {
+    json hidden = json::array(), output = json::array();
+    for (const auto& row : n.hiddenWeights) hidden.push_back(precise(row));
+    for (const auto& row : n.outputWeights) output.push_back(precise(row));
+    return {{"classes", n.classes},
+            {"input_mean", precise(n.inputMean)},
+            {"input_scale", precise(n.inputScale)},
+            {"hidden_weights", hidden},
+            {"hidden_bias", precise(n.hiddenBias)},
+            {"output_weights", output},
+            {"output_bias", precise(n.outputBias)},
+            {"log_prior", precise(n.logPrior)}};
+}
 }  // namespace
 
 void TemplateSet::validate(const std::string& source) const {
@@ -158,6 +187,18 @@ void TemplateSet::validate(const std::string& source) const {
     if (jawNetwork) jawNetwork->validate(bins, source);
     if (classes.empty()) throw InputError(source, 0, "no classes");
     const PhonemeSet& set = PhonemeSet::common();
+    if (classNetwork) {
+        classNetwork->validate(bins, source);
+        const auto& names = classNetwork->classes;
+        for (std::size_t c = 0; c < names.size(); ++c) {
+            const std::string where = "class_network.classes[" + std::to_string(c) + "]";
+            if (!set.find(names[c]))
+                throw InputError(source, 0, where + ": '" + names[c] + "' is not a phoneme class");
+            if (std::find(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(c),
+                          names[c]) != names.begin() + static_cast<std::ptrdiff_t>(c))
+                throw InputError(source, 0, where + ": '" + names[c] + "' listed twice");
+        }
+    }
     for (std::size_t c = 0; c < classes.size(); ++c) {
         const auto& cls = classes[c];
         const std::string where = "classes[" + std::to_string(c) + "] ('" + cls.phoneme + "')";
@@ -193,6 +234,8 @@ TemplateSet TemplateSet::load(const std::filesystem::path& file) {
         t.whitening = member<std::vector<std::vector<float>>>(j, "whitening", "", source);
     if (j.contains("jaw_network"))
         t.jawNetwork = readJawNetwork(member<json>(j, "jaw_network", "", source), source);
+    if (j.contains("class_network"))
+        t.classNetwork = readClassNetwork(member<json>(j, "class_network", "", source), source);
     const auto classes = member<json>(j, "classes", "", source);
     if (!classes.is_array()) throw InputError(source, 0, "field 'classes' must be an array");
     for (std::size_t i = 0; i < classes.size(); ++i) {
@@ -236,6 +279,7 @@ void TemplateSet::save(const std::filesystem::path& file) const {
         j["whitening"] = rows;
     }
     if (jawNetwork) j["jaw_network"] = writeJawNetwork(*jawNetwork);
+    if (classNetwork) j["class_network"] = writeClassNetwork(*classNetwork);
     std::ofstream out(file);
     if (!out) throw InputError(file.string() + ": cannot write");
     out << j.dump(1) << '\n';

@@ -80,7 +80,8 @@ void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames,
                                    const PhonemeSchedule& labels) {
     float peak = -120;
     for (const auto& f : frames) peak = std::max(peak, f.energyDb);
-    if (options_.jawHiddenUnits > 0) addJawFrames(frames, labels, peak);
+    if (options_.jawHiddenUnits > 0 || options_.classHiddenUnits > 0)
+        addNetworkFrames(frames, labels, peak);
     std::size_t seg = 0;
     for (const auto& f : frames) {
         while (seg < labels.size() && labels[seg].end <= f.time) ++seg;
@@ -99,29 +100,39 @@ void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames,
     }
 }
 
-// The jaw network learns from every frame of speech, transitions included (the jaw moves
-// through them too), against what `lipsync eval` scores a jaw on: each frame's phoneme jaw
-// height, averaged over the frames within 20 ms (lipsync::JawScoreConfig::smoothingSeconds).
-void TemplateTrainer::addJawFrames(std::span<const FrameFeatures> frames,
-                                   const PhonemeSchedule& labels, float peak) {
+// The networks learn from every frame of speech, transitions included (the jaw moves through
+// them too, and the aligner weighs every frame). The jaw network's target is what `lipsync
+// eval` scores a jaw on: each frame's phoneme jaw height, averaged over the frames within 20 ms
+// (lipsync::JawScoreConfig::smoothingSeconds); the class network's is the frame's own class.
+void TemplateTrainer::addNetworkFrames(std::span<const FrameFeatures> frames,
+                                       const PhonemeSchedule& labels, float peak) {
     std::vector<float> height(frames.size(), 0.0f);
+    std::vector<int> cls(frames.size(), static_cast<int>(set_->silence()));
     std::size_t seg = 0;
     for (std::size_t i = 0; i < frames.size(); ++i) {
         while (seg < labels.size() && labels[seg].end <= frames[i].time) ++seg;
         if (seg >= labels.size() || frames[i].time < labels[seg].start) continue;  // silence
-        const auto cls = set_->find(labels[seg].phoneme);
-        if (!cls || !(*set_)[*cls].jaw) return;  // a set without jaw heights: nothing to learn
-        height[i] = *(*set_)[*cls].jaw;
+        const auto c = set_->find(labels[seg].phoneme);
+        if (!c) {
+            cls[i] = -1;
+            continue;
+        }
+        cls[i] = static_cast<int>(*c);
+        if (const auto jaw = (*set_)[*c].jaw)
+            height[i] = *jaw;
+        else
+            jawUsable_ = false;  // a set without jaw heights: no jaw network
     }
     const auto half = static_cast<std::size_t>(std::lround(0.02 / options_.analysis.hopSeconds));
     for (std::size_t i = 0; i < frames.size(); ++i) {
         const auto& f = frames[i];
-        if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb) continue;
+        if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb || cls[i] < 0) continue;
         const std::size_t lo = i > half ? i - half : 0, hi = std::min(frames.size(), i + half + 1);
         float sum = 0;
         for (std::size_t k = lo; k < hi; ++k) sum += height[k];
         jawTargets_.push_back(sum / static_cast<float>(hi - lo));
-        jawInputs_.insert(jawInputs_.end(), f.spectrum.begin(), f.spectrum.end());
+        classTargets_.push_back(static_cast<std::uint16_t>(cls[i]));
+        networkInputs_.insert(networkInputs_.end(), f.spectrum.begin(), f.spectrum.end());
     }
 }
 
@@ -138,6 +149,25 @@ void TemplateTrainer::addSustained(std::span<const FrameFeatures> frames,
 std::size_t TemplateTrainer::frames(const std::string& phoneme) const {
     const auto cls = set_->find(phoneme);
     return cls ? spectra_[*cls].size() : 0;
+}
+
+// Over the classes with frames (a class never heard cannot be told apart): their names in set
+// order, and every frame's label re-indexed to them.
+std::optional<ClassNetwork> TemplateTrainer::trainClasses(std::size_t bins) const {
+    std::vector<int> index(set_->size(), -1);
+    std::vector<std::string> names;
+    for (auto c : classTargets_) index[c] = 0;
+    for (std::size_t c = 0; c < set_->size(); ++c)
+        if (index[c] == 0) {
+            index[c] = static_cast<int>(names.size());
+            names.push_back((*set_)[c].name);
+        }
+    if (names.size() < 2) return std::nullopt;
+    std::vector<std::uint16_t> labels;
+    labels.reserve(classTargets_.size());
+    for (auto c : classTargets_) labels.push_back(static_cast<std::uint16_t>(index[c]));
+    return trainClassNetwork(networkInputs_, labels, names, bins, options_.classHiddenUnits,
+                             options_.classEpochs, options_.seed);
 }
 
 TemplateSet TemplateTrainer::build(const std::string& description) const {
@@ -184,12 +214,14 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
     double inverseSum = 0;
     for (std::size_t b = 0; b < bins; ++b) inverseSum += 1.0 / covariance[b * bins + b];
     t.binWeights.resize(bins);
-    // Enough speech for the network to learn more than one voice's quirks: else none, and the
-    // jaw comes from the class distances.
-    constexpr std::size_t kMinJawFrames = 2000;
-    if (options_.jawHiddenUnits > 0 && jawTargets_.size() >= kMinJawFrames)
-        t.jawNetwork = trainJawNetwork(jawInputs_, jawTargets_, bins, options_.jawHiddenUnits,
+    // Enough speech for a network to learn more than one voice's quirks: else none, and the
+    // jaw comes from the class distances, the classes from the templates alone.
+    constexpr std::size_t kMinNetworkFrames = 2000;
+    const bool enough = jawTargets_.size() >= kMinNetworkFrames;
+    if (options_.jawHiddenUnits > 0 && jawUsable_ && enough)
+        t.jawNetwork = trainJawNetwork(networkInputs_, jawTargets_, bins, options_.jawHiddenUnits,
                                        options_.jawEpochs, options_.seed);
+    if (options_.classHiddenUnits > 0 && enough) t.classNetwork = trainClasses(bins);
     if (options_.fullCovariance) {
         // Scaled so that a frame's expected distance to its own class's mean is what the
         // per-bin weights give (the harmonic mean of the variances, in dB²): the decoder's and

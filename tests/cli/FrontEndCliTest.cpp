@@ -245,15 +245,17 @@ TEST(LipsyncCli, CalibrateFromReadSpeechReplacesTheClassesItHeard) {
     EXPECT_NE(spectraOf(own, "bmp"), spectraOf(base, "bmp")) << "b, m, p were heard: replaced";
     EXPECT_NE(spectraOf(own, "ih"), spectraOf(base, "ih"));
     EXPECT_EQ(spectraOf(own, "oy"), spectraOf(base, "oy")) << "no oy in these lines: kept";
-    // Half a minute of one voice trains no jaw network: the base set's stays.
+    // Half a minute of one voice trains no network: the base set's stay.
     ASSERT_TRUE(own.jawNetwork && base.jawNetwork);
     EXPECT_EQ(own.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
+    ASSERT_TRUE(own.classNetwork && base.classNetwork);
+    EXPECT_EQ(own.classNetwork->outputWeights, base.classNetwork->outputWeights);
 }
 
-// train --keep-templates: only the jaw network is trained, on the labelled speech given; the
-// set's analysis, templates and weights are written back as they were. Too little speech for a
-// network is an error, not a set without one.
-TEST(LipsyncCli, TrainKeepTemplatesAddsOnlyTheJawNetwork) {
+// train --keep-templates: only the networks asked for are trained, on the labelled speech given;
+// the set's analysis, templates, weights and other network are written back as they were. Too
+// little speech for a network is an error, not a set without one.
+TEST(LipsyncCli, TrainKeepTemplatesReplacesOnlyTheNetworksAskedFor) {
     const auto dir = scratchDir("cli_train_jaw");
     const char* lines[] = {"Hello puppet, open wide and sing to me.",
                            "Bob bought a big bag of beans by the bay.",
@@ -271,18 +273,35 @@ TEST(LipsyncCli, TrainKeepTemplatesAddsOnlyTheJawNetwork) {
         }
     const auto out = dir.parent_path() / "with-jaw.json";
     auto r = runLipsync({"train", dir.string(), "--keep-templates", "default", "--jaw-hidden", "8",
-                         "-o", out.string()});
+                         "--class-hidden", "0", "-o", out.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto set = dsp::TemplateSet::load(out);
     const auto base = dsp::TemplateSet::loadDefault();
     ASSERT_TRUE(set.jawNetwork.has_value());
     EXPECT_EQ(set.jawNetwork->hiddenUnits(), 8u);
+    ASSERT_TRUE(set.classNetwork && base.classNetwork);  // not asked for: the base's stays
+    EXPECT_EQ(set.classNetwork->hiddenUnits(), base.classNetwork->hiddenUnits());
+    EXPECT_EQ(set.classNetwork->classes, base.classNetwork->classes);
     ASSERT_EQ(set.classes.size(), base.classes.size());
     for (std::size_t c = 0; c < set.classes.size(); ++c)
         for (std::size_t k = 0; k < set.classes[c].spectra.size(); ++k)
             for (std::size_t b = 0; b < set.classes[c].spectra[k].size(); ++b)
                 ASSERT_NEAR(set.classes[c].spectra[k][b], base.classes[c].spectra[k][b], 1e-3);
     EXPECT_EQ(set.analysis.featureCount(), base.analysis.featureCount());
+
+    // Now the class network alone, into that set: its jaw network stays.
+    const auto both = dir.parent_path() / "with-both.json";
+    r = runLipsync({"train", dir.string(), "--keep-templates", out.string(), "--jaw-hidden", "0",
+                    "--class-hidden", "8", "-o", both.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto second = dsp::TemplateSet::load(both);
+    ASSERT_TRUE(second.classNetwork && second.jawNetwork);
+    EXPECT_EQ(second.classNetwork->hiddenUnits(), 8u);
+    EXPECT_EQ(second.jawNetwork->hiddenUnits(), 8u);
+    r = runLipsync({"train", dir.string(), "--keep-templates", "default", "--jaw-hidden", "0",
+                    "--class-hidden", "0", "-o", both.string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("nothing to train"), std::string::npos) << r.err;
 
     fs::create_directories(dir / "one");
     fs::copy_file(dir / "s0-en-us.wav", dir / "one/s0.wav", fs::copy_options::overwrite_existing);

@@ -16,8 +16,13 @@
 using namespace lipsyncd;
 
 namespace {
+// The shipped templates without their class network: the kernels' search alone is checked.
 const dsp::TemplateSet& templates() {
-    static const auto t = dsp::TemplateSet::loadDefault();
+    static const auto t = [] {
+        auto set = dsp::TemplateSet::loadDefault();
+        set.classNetwork.reset();
+        return set;
+    }();
     return t;
 }
 

@@ -7,6 +7,8 @@
 #include <random>
 #include <string>
 
+#include "ExpectRejected.hpp"
+
 using namespace lipsyncd;
 using namespace lipsyncd::dsp;
 
@@ -83,24 +85,16 @@ TEST(Mahalanobis, TheWhiteningTravelsWithTheTemplatesAndIsValidated) {
                         1e-4 * std::abs(t.whitening[r][c]));
     EXPECT_GT(accuracy(back, rng), 0.95);
 
-    const auto rejects = [&](TemplateSet bad, const std::string& named) {
-        try {
-            bad.validate("set.json");
-            ADD_FAILURE() << "accepted a whitening with " << named;
-        } catch (const InputError& e) {
-            EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
-        }
-    };
     auto bad = t;
     bad.whitening.pop_back();
-    rejects(bad, "whitening has 3 rows");
+    test::expectRejected(bad, "whitening has 3 rows");
     bad = t;
     bad.whitening[1][3] = 0.5f;  // above the diagonal
-    rejects(bad, "whitening[1][3]");
+    test::expectRejected(bad, "whitening[1][3]");
     bad = t;
     bad.whitening[2][2] = 0;
-    rejects(bad, "whitening[2][2]");
+    test::expectRejected(bad, "whitening[2][2]");
     bad = t;
     bad.whitening[0].push_back(1);
-    rejects(bad, "whitening[0] has 5 values");
+    test::expectRejected(bad, "whitening[0] has 5 values");
 }

@@ -1,0 +1,173 @@
+// The class network (TemplateSet::classNetwork): that it tells apart classes the templates
+// cannot, that training is reproducible, that the aligner still weighs the templates alone, and
+// its file form and validation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <lipsyncd/dsp.hpp>
+#include <random>
+#include <string>
+
+#include "ExpectRejected.hpp"
+
+using namespace lipsyncd;
+using namespace lipsyncd::dsp;
+
+namespace {
+// Two classes, each heard two ways: "aa" with bins 0 and 1 both high or both low, "ih" with one
+// high and the other low. Each class's mean (one template a class) is the same flat spectrum,
+// so the templates cannot tell them apart; a network can (an exclusive or).
+struct Utterance {
+    std::vector<FrameFeatures> frames;
+    PhonemeSchedule labels;
+};
+
+Utterance utterance(std::mt19937& rng, int segments = 40) {
+    std::normal_distribution<float> noise(0, 1);
+    std::bernoulli_distribution coin;
+    Utterance u;
+    double t = 0;
+    for (int segment = 0; segment < segments; ++segment) {
+        const bool aa = segment % 2 == 0;
+        u.labels.push_back({t, t + 0.2, aa ? "aa" : "ih", 1});
+        for (int i = 0; i < 20; ++i, t += 0.01) {
+            FrameFeatures f;
+            f.valid = true;
+            f.energyDb = -20;
+            f.time = t + 0.005;
+            const float a = coin(rng) ? 8.0f : -8.0f, b = aa ? a : -a;
+            f.spectrum = {a + noise(rng), b + noise(rng), noise(rng), noise(rng)};
+            u.frames.push_back(std::move(f));
+        }
+    }
+    return u;
+}
+
+TemplateSet train(std::mt19937& rng, int hiddenUnits = 8, int utterances = 4) {
+    TrainingOptions options;
+    options.analysis = AnalysisConfig{};  // the spectrum alone, 4 bins
+    options.analysis.spectrumBins = 4;
+    options.clustersPerClass = 1;
+    options.jawHiddenUnits = 0;
+    options.classHiddenUnits = hiddenUnits;
+    options.classEpochs = 20;
+    TemplateTrainer trainer(options, PhonemeSet::common());
+    for (int i = 0; i < utterances; ++i) {
+        const auto u = utterance(rng);
+        trainer.addUtterance(u.frames, u.labels);
+    }
+    return trainer.build("test");
+}
+
+// Share of new frames the classifier decides right.
+double accuracy(const TemplateSet& t, std::mt19937& rng, float classNetworkDb) {
+    ClassifierConfig config;
+    config.classNetworkDb = classNetworkDb;
+    const auto& set = PhonemeSet::common();
+    FrameClassifier classifier(t, set, config);
+    const auto u = utterance(rng);
+    int right = 0;
+    for (const auto& f : u.frames) {
+        const auto label = classifier.classify(f);
+        for (const auto& s : u.labels)
+            if (f.time >= s.start && f.time < s.end) right += set[label.phoneme].name == s.phoneme;
+    }
+    return static_cast<double>(right) / static_cast<double>(u.frames.size());
+}
+}  // namespace
+
+TEST(ClassNetwork, TellsApartClassesTheTemplatesCannot) {
+    std::mt19937 rng(4);
+    const auto t = train(rng);
+    ASSERT_TRUE(t.classNetwork.has_value());
+    EXPECT_EQ(t.classNetwork->hiddenUnits(), 8u);
+    EXPECT_EQ(t.classNetwork->classes, (std::vector<std::string>{"aa", "ih"}));
+    const double withNetwork = accuracy(t, rng, 1.0f), templatesAlone = accuracy(t, rng, 0.0f);
+    EXPECT_GT(withNetwork, 0.95);
+    EXPECT_LT(templatesAlone, 0.75);  // a coin, near enough
+}
+
+TEST(ClassNetwork, TrainingIsReproducibleAndTooLittleSpeechTrainsNone) {
+    std::mt19937 a(5), b(5), c(5);
+    const auto first = train(a), second = train(b);
+    ASSERT_TRUE(first.classNetwork && second.classNetwork);
+    EXPECT_EQ(first.classNetwork->hiddenWeights, second.classNetwork->hiddenWeights);
+    EXPECT_EQ(first.classNetwork->outputWeights, second.classNetwork->outputWeights);
+    EXPECT_EQ(first.classNetwork->logPrior, second.classNetwork->logPrior);
+    // 800 frames: one voice's quirks, not its classes.
+    EXPECT_FALSE(train(c, 8, 1).classNetwork.has_value());
+}
+
+TEST(ClassNetwork, TheAlignerStillWeighsTheTemplatesAlone) {
+    std::mt19937 rng(6);
+    const auto t = train(rng);
+    ClassifierConfig off;
+    off.classNetworkDb = 0;
+    FrameClassifier with(t, PhonemeSet::common()), without(t, PhonemeSet::common(), off);
+    const auto u = utterance(rng, 4);
+    bool differs = false;
+    for (const auto& f : u.frames) {
+        with.classify(f);
+        without.classify(f);
+        const auto d = with.distances(), alone = with.templateDistances(),
+                   ref = without.distances();
+        ASSERT_EQ(d.size(), ref.size());
+        for (std::size_t c = 0; c < d.size(); ++c) {
+            EXPECT_EQ(alone[c], ref[c]);
+            if (std::isfinite(d[c])) {
+                EXPECT_GE(d[c], ref[c]);  // the network only ever adds
+                differs |= d[c] > ref[c];
+            }
+        }
+    }
+    EXPECT_TRUE(differs);
+    auto broken = u.frames[3];  // a NaN in the features reaches no distance through the network
+    broken.spectrum[1] = std::nanf("");
+    with.classify(broken);
+    without.classify(broken);
+    for (std::size_t c = 0; c < with.distances().size(); ++c)
+        if (std::isfinite(without.distances()[c])) {
+            EXPECT_FALSE(std::isnan(with.distances()[c]));
+        }
+}
+
+TEST(ClassNetwork, TravelsWithTheTemplatesAndIsValidated) {
+    std::mt19937 rng(3);
+    const auto t = train(rng);
+    const auto path = std::filesystem::temp_directory_path() / "lipsyncd_class_network.json";
+    t.save(path);
+    const auto back = TemplateSet::load(path);
+    ASSERT_TRUE(back.classNetwork.has_value());
+    EXPECT_EQ(back.classNetwork->classes, t.classNetwork->classes);
+    const auto u = utterance(rng, 2);
+    std::vector<float> a(2), b(2), scratch(8);
+    for (std::size_t i = 0; i < u.frames.size(); i += 7) {
+        back.classNetwork->scaledLogLikelihoods(u.frames[i].spectrum, a, scratch);
+        t.classNetwork->scaledLogLikelihoods(u.frames[i].spectrum, b, scratch);
+        EXPECT_NEAR(a[0] - a[1], b[0] - b[1], 1e-2);
+    }
+
+    auto bad = t;
+    bad.classNetwork->outputWeights[1].pop_back();
+    test::expectRejected(bad, "class_network.output_weights[1] has 1 values, expected 2");
+    bad = t;
+    bad.classNetwork->outputWeights.pop_back();
+    test::expectRejected(bad, "class_network.output_weights has 7 values, expected 8");
+    bad = t;
+    bad.classNetwork->logPrior.pop_back();
+    test::expectRejected(bad, "class_network.log_prior has 1 values, expected 2");
+    bad = t;
+    bad.classNetwork->hiddenWeights[0].push_back(1);
+    test::expectRejected(bad, "class_network.hidden_weights[0] has 9 values, expected 8");
+    bad = t;
+    bad.classNetwork->outputBias[0] = std::numeric_limits<float>::quiet_NaN();
+    test::expectRejected(bad, "class_network.output_bias[0]");
+    bad = t;
+    bad.classNetwork->classes[1] = "xx";
+    test::expectRejected(bad, "class_network.classes[1]: 'xx' is not a phoneme class");
+    bad = t;
+    bad.classNetwork->classes[1] = "aa";
+    test::expectRejected(bad, "class_network.classes[1]: 'aa' listed twice");
+}
