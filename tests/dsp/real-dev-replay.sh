@@ -7,6 +7,9 @@
 #
 #   real-dev-replay.sh LIPSYNC OUT_DIR SUBSET SPEAKER=GROUP_FLOOR:JAW_FLOOR[:CLOSURES:FALSE]...
 #
+# REPLAY_TEMPLATES=SET scores that template set (a name under config/templates/ or a file)
+# instead of the default one.
+#
 # Exits 77 (ctest: skipped) only when scripts/fetch-real-speech.sh cannot fetch the packages
 # or tools; any other failure fails the test.
 set -uo pipefail
@@ -24,9 +27,10 @@ failed=0
 for pair in "$@"; do
   speaker="${pair%%=*}"
   IFS=: read -r group jaw closures falseClosures <<<"${pair#*=}"
-  echo "== $speaker (floors: visual groups $group, jaw r from audio $jaw," \
+  echo "== $speaker, templates ${REPLAY_TEMPLATES:-default} (floors: visual groups $group, jaw r from audio $jaw," \
     "closures caught ${closures:-0}, false closures at most ${falseClosures:-1})"
-  "$lipsync" eval --corpus "$out/dev/$speaker" --no-per-file --min-group-accuracy "$group" \
+  "$lipsync" eval --corpus "$out/dev/$speaker" --no-per-file --templates "${REPLAY_TEMPLATES:-default}" \
+    --min-group-accuracy "$group" \
     --min-jaw-r "$jaw" --min-closures "${closures:-0}" --max-false-closures "${falseClosures:-1}" \
     --min-exact-jaw-r 0.92 --min-exact-closures 0.95 |
     tail -2 || failed=1
