@@ -176,8 +176,7 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     std::vector<int> networkClass;
     std::vector<float> likelihoods, scratch;
     if (templates.classNetwork) {
-        for (const auto& name : templates.classNetwork->classes)
-            networkClass.push_back(static_cast<int>(*set.find(name)));
+        networkClass = templates.classNetwork->setIndices(set);
         likelihoods.resize(networkClass.size());
         scratch.resize(templates.classNetwork->hiddenUnits());
     }
@@ -243,11 +242,9 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
             clock.time(Classes, [&] {
                 for (std::size_t k = 0; k < count; ++k) {
                     if (!features[k].valid) continue;
-                    templates.classNetwork->scaledLogLikelihoods(features[k].spectrum, likelihoods,
-                                                                 scratch);
-                    const float best = *std::max_element(likelihoods.begin(), likelihoods.end());
-                    for (std::size_t o = 0; o < likelihoods.size(); ++o)
-                        distances[k][networkClass[o]] += classNetworkDb * (best - likelihoods[o]);
+                    templates.classNetwork->addToDistances(features[k].spectrum, networkClass,
+                                                           classNetworkDb, distances[k],
+                                                           likelihoods, scratch);
                 }
             });
         if (templates.jawNetwork)

@@ -40,6 +40,7 @@ done <"$here/config/corpus/real-speakers.txt"
 # 67.6 % on the espeak-ng dev corpus and the worst real dev speaker stayed within a point.
 out="$here/config/templates/default.json"
 about="espeak-ng $(espeak-ng --version | awk '{print $4}') speech (12 voices and variants, 40 sentences) and real speakers ${speakers[*]}"
+kind="Default templates" detail="24 clusters a class" channel=()
 if [ "${1:-}" = --channel-normalised ]; then
   # A running mean spectrum subtracted from every frame (Atal 1974), the training mean worth 2 s
   # of speech. Chosen on the real training speakers each left out of their own set (klettres-en-gb
@@ -48,12 +49,12 @@ if [ "${1:-}" = --channel-normalised ]; then
   # 44.9 and 84.7 / 54.3 % at 5 s). Opt-in (--templates channel-normalised): the aligner's costs
   # were tuned on unnormalised distances (README, "Real people").
   out="$here/config/templates/channel-normalised.json"
-  "$lipsync" train "${folders[@]}" --clusters 24 --normalise-channel --mean-prior 2 \
-    --jaw-hidden 0 --class-hidden 0 -o "$out" \
-    --description "Channel-normalised templates: trained by scripts/train-templates.sh on $about (24 clusters a class, the running mean spectrum subtracted)"
-elif [ "${1:-}" != --networks-only ]; then
-  "$lipsync" train "${folders[@]}" --clusters 24 --jaw-hidden 0 --class-hidden 0 -o "$out" \
-    --description "Default templates: trained by scripts/train-templates.sh on $about (24 clusters a class)"
+  kind="Channel-normalised templates" detail="$detail, the running mean spectrum subtracted"
+  channel=(--normalise-channel --mean-prior 2)
+fi
+if [ "${1:-}" != --networks-only ]; then
+  "$lipsync" train "${folders[@]}" --clusters 24 "${channel[@]}" --jaw-hidden 0 --class-hidden 0 \
+    -o "$out" --description "$kind: trained by scripts/train-templates.sh on $about ($detail)"
 fi
 # Both networks 32 hidden units, 4 passes: more units or passes did no better on the real
 # training speakers each left out of their own set (jaw network, 64 units and 8 passes:

@@ -44,6 +44,27 @@ LIPSYNCD_VECTOR_CLONES void ClassNetwork::scaledLogLikelihoods(std::span<const f
         if (!std::isfinite(out[c])) out[c] = 0;
 }
 
+std::vector<int> ClassNetwork::setIndices(const PhonemeSet& set) const {
+    std::vector<int> indices;
+    for (const auto& name : classes) {
+        const auto idx = set.find(name);
+        indices.push_back(idx ? static_cast<int>(*idx) : -1);
+    }
+    return indices;
+}
+
+void ClassNetwork::addToDistances(std::span<const float> features, std::span<const int> setIndices,
+                                  float dbPerNat, std::span<float> distances,
+                                  std::span<float> likelihoods, std::span<float> scratch) const {
+    scaledLogLikelihoods(features, likelihoods, scratch);
+    const float best = *std::max_element(likelihoods.begin(), likelihoods.end());
+    for (std::size_t o = 0; o < likelihoods.size(); ++o) {
+        const int c = setIndices[o];
+        if (c >= 0 && std::isfinite(distances[c]))
+            distances[c] += dbPerNat * (best - likelihoods[o]);
+    }
+}
+
 void ClassNetwork::validate(std::size_t features, const std::string& source) const {
     network::validateHiddenLayer(hiddenLayer(*this), features, "class_network", source);
     const std::size_t units = hiddenBias.size(), count = classes.size();

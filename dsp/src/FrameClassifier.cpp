@@ -24,10 +24,7 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
     : set_(&set), config_(config), jawNetwork_(templates.jawNetwork) {
     if (templates.classNetwork && config.classNetworkDb > 0) {
         classNetwork_ = templates.classNetwork;
-        for (const auto& name : classNetwork_->classes) {
-            const auto idx = set.find(name);
-            networkClass_.push_back(idx ? static_cast<int>(*idx) : -1);
-        }
+        networkClass_ = classNetwork_->setIndices(set);
         likelihoods_.assign(networkClass_.size(), 0.0f);
         hiddenUnits_.assign(classNetwork_->hiddenUnits(), 0.0f);
         templateDistances_.assign(set.size(), std::numeric_limits<float>::infinity());
@@ -64,18 +61,12 @@ float FrameClassifier::expectedJaw(float best) const {
     return sum > 0 ? weighted / sum : 0.0f;
 }
 
-// The hybrid's scaled likelihoods (Bourlard & Morgan 1994) as distance: each class lies
-// classNetworkDb dB further off per nat its likelihood falls short of the likeliest class's.
-// Classes the network does not know keep their template distance.
+// The hybrid's scaled likelihoods (Bourlard & Morgan 1994) as distance, the templates' own
+// distances kept for the aligner. Classes the network does not know keep their template distance.
 void FrameClassifier::addClassNetwork(const FrameFeatures& frame) {
     std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
-    classNetwork_->scaledLogLikelihoods(frame.spectrum, likelihoods_, hiddenUnits_);
-    const float best = *std::max_element(likelihoods_.begin(), likelihoods_.end());
-    for (std::size_t o = 0; o < likelihoods_.size(); ++o) {
-        const int c = networkClass_[o];
-        if (c >= 0 && std::isfinite(distances_[c]))
-            distances_[c] += config_.classNetworkDb * (best - likelihoods_[o]);
-    }
+    classNetwork_->addToDistances(frame.spectrum, networkClass_, config_.classNetworkDb, distances_,
+                                  likelihoods_, hiddenUnits_);
 }
 
 FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {

@@ -248,7 +248,8 @@ struct JawNetwork {
 // a softmax output over the classes (Bourlard & Morgan 1994, the hybrid of a multilayer
 // perceptron and a hidden Markov model): its posteriors divided by the classes' shares of the
 // training frames are scaled likelihoods, which the classifier adds to the template distances
-// (ClassifierConfig::classNetworkDb) for the decoder and the aligner to weigh.
+// (ClassifierConfig::classNetworkDb) for the decoder to weigh (the aligner weighs the templates
+// alone: FrameClassifier::templateDistances).
 struct ClassNetwork {
     std::vector<std::string> classes;               // output order: phoneme set names
     std::vector<float> inputMean, inputScale;       // per feature: x' = (x − mean) · scale
@@ -264,6 +265,15 @@ struct ClassNetwork {
     // hiddenUnits() values. No allocation.
     void scaledLogLikelihoods(std::span<const float> features, std::span<float> out,
                               std::span<float> scratch) const;
+    // Per output, its class's index in `set` (-1: not in the set).
+    std::vector<int> setIndices(const PhonemeSet& set) const;
+    // The hybrid's term added to `distances` (indexed by set index): each class the network
+    // knows (`setIndices` ≥ 0) whose distance is finite lies `dbPerNat` dB further off per nat
+    // its scaled likelihood falls short of the likeliest class's. `likelihoods` (classes.size()
+    // values) and `scratch` (hiddenUnits()) are working space. No allocation.
+    void addToDistances(std::span<const float> features, std::span<const int> setIndices,
+                        float dbPerNat, std::span<float> distances, std::span<float> likelihoods,
+                        std::span<float> scratch) const;
     // InputError naming `source` and the field when sizes disagree or a value is not finite.
     void validate(std::size_t features, const std::string& source) const;
 };
