@@ -100,6 +100,9 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
     // Distances: weighted RMS difference in dB to the nearest template of each class.
     std::fill(distances_.begin(), distances_.end(), std::numeric_limits<float>::infinity());
     if (!frame.valid) {  // digital silence or a degenerate frame: nothing to compare
+        // The templates' own distances (templateDistances()) too, not the last frame's.
+        std::fill(templateDistances_.begin(), templateDistances_.end(),
+                  std::numeric_limits<float>::infinity());
         label.phoneme = label.runnerUp = sil_;
         label.distance = label.runnerUpDistance = 0;
         label.confidence = 1;

@@ -123,6 +123,12 @@ TEST(ClassNetwork, TheAlignerStillWeighsTheTemplatesAlone) {
         }
     }
     EXPECT_TRUE(differs);
+    auto silent = u.frames[3];  // digital silence after speech: nothing to compare, as alone
+    silent.valid = false;
+    with.classify(silent);
+    without.classify(silent);
+    for (std::size_t c = 0; c < with.templateDistances().size(); ++c)
+        EXPECT_EQ(with.templateDistances()[c], without.distances()[c]) << c;
     auto broken = u.frames[3];  // a NaN in the features reaches no distance through the network
     broken.spectrum[1] = std::nanf("");
     with.classify(broken);
