@@ -108,12 +108,14 @@ void warnAboutWords(AlignFileResult& r) {
 }
 }  // namespace
 
-double estimateTimeScale(std::span<const ScriptWord> script, const std::filesystem::path& file,
-                         const DecodeOptions& decode, const std::optional<RawFormat>& raw) {
+SpeechTiming measureSpeechTiming(std::span<const ScriptWord> script,
+                                 const std::filesystem::path& file, const DecodeOptions& decode,
+                                 const std::optional<RawFormat>& raw) {
     auto decoder = AudioDecoder::open(file, decode, raw);
     const auto blockSize = std::max<std::size_t>(1, decoder.sampleRate() / 100);
     std::vector<float> block(blockSize);
     std::vector<float> levels;  // dBFS per 10 ms: 400 bytes a second of audio
+    std::int64_t samples = 0;
     for (;;) {
         std::size_t got = 0;
         while (got < blockSize) {
@@ -122,12 +124,15 @@ double estimateTimeScale(std::span<const ScriptWord> script, const std::filesyst
             got += n;
         }
         if (got == 0) break;
+        samples += got;
         double sum = 0;
         for (std::size_t i = 0; i < got; ++i) sum += double(block[i]) * block[i];
         levels.push_back(static_cast<float>(10 * std::log10(sum / got + 1e-20)));
         if (got < blockSize) break;
     }
-    if (levels.empty()) return 1.0;
+    SpeechTiming timing;
+    timing.durationSeconds = static_cast<double>(samples) / decoder.sampleRate();
+    if (levels.empty()) return timing;
     const double peak = *std::max_element(levels.begin(), levels.end());
     auto sorted = levels;
     const auto roomAt =
@@ -142,9 +147,10 @@ double estimateTimeScale(std::span<const ScriptWord> script, const std::filesyst
             last = i;
         }
     const double expected = scriptSeconds(script);
-    if (first > last || expected <= 0) return 1.0;
+    if (first > last || expected <= 0) return timing;
     const double speech = static_cast<double>(last - first + 1) * 0.01;
-    return std::clamp(speech / expected, kMinTimeScale, kMaxTimeScale);
+    timing.timeScale = std::clamp(speech / expected, kMinTimeScale, kMaxTimeScale);
+    return timing;
 }
 
 AlignFileResult alignFile(const std::filesystem::path& file, std::span<const ScriptWord> script,
@@ -152,10 +158,14 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
                           const FrontEndConfig& config, const AlignerConfig& alignerConfig,
                           const DecodeOptions& decode, const std::optional<RawFormat>& raw) {
     AlignFileResult r;
-    if (file != "-") r.timeScale = estimateTimeScale(script, file, decode, raw);
+    SpeechTiming timing;
+    if (file != "-") timing = measureSpeechTiming(script, file, decode, raw);
+    r.timeScale = timing.timeScale;
     auto decoder = AudioDecoder::open(file, decode, raw);
     StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
     ForcedAligner aligner(script, set, templates.analysis.hopSeconds, r.timeScale, alignerConfig);
+    if (timing.durationSeconds > 0)
+        aligner.expectFrames(std::llround(timing.durationSeconds / templates.analysis.hopSeconds));
     std::size_t speechFrames = 0;
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
         aligner.push(f.label.time, analyzer.templateDistances(), f.label.silent);

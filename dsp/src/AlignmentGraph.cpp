@@ -36,14 +36,17 @@ class GraphBuilder {
         incoming_.emplace_back();
         return static_cast<int>(graph_.nodes.size()) - 1;
     }
-    void edge(int from, int to, float cost) { incoming_[to].push_back({from, cost}); }
+    void edge(int from, int to, float cost, bool skips = false) {
+        incoming_[to].push_back({from, cost, skips});
+    }
 
     // Edges into `to` from the end of the unit before it, and, skipping words, from earlier.
     void fromPreviousUnits(int to, std::size_t unit, float cost) {
         for (int skipped = 0; skipped <= kMaxSkippedInARow && skipped < static_cast<int>(unit);
              ++skipped)
             for (int from : units_[unit - 1 - skipped])
-                edge(from, to, cost + config_.skipWordCost * static_cast<float>(skipped));
+                edge(from, to, cost + config_.skipWordCost * static_cast<float>(skipped),
+                     skipped > 0);
     }
 
     // The pause and filler before word `gap` (after the last word when gap == words).
@@ -75,7 +78,7 @@ class GraphBuilder {
             for (int from : units_[unit]) edge(from, node, enter);
             for (int s = 1; s <= kMaxSkippedInARow && s <= static_cast<int>(unit); ++s)
                 for (int from : units_[unit - s])  // the words between skipped
-                    edge(from, node, enter + config_.skipWordCost * static_cast<float>(s));
+                    edge(from, node, enter + config_.skipWordCost * static_cast<float>(s), true);
         }
         edge(last, f, 0);  // a pause, then something else; edges only go forward
         units_.back().push_back(last);
@@ -171,6 +174,23 @@ class GraphBuilder {
                 if (graph_.nodes[node].kind != AlignmentNode::Kind::Start)
                     graph_.endCost[node] = std::min(graph_.endCost[node],
                                                     config_.skipWordCost * static_cast<float>(s));
+        countFramesToEnd();
+    }
+
+    // Backwards over the nodes (every edge goes forward): a node's successors are done first.
+    void countFramesToEnd() {
+        const int n = static_cast<int>(graph_.nodes.size());
+        constexpr int kUnreachable = std::numeric_limits<int>::max() / 2;
+        graph_.framesToEnd.assign(n, kUnreachable);
+        for (int to = n - 1; to >= 0; --to) {
+            if (graph_.endCost[to] == 0) graph_.framesToEnd[to] = 0;  // after the last word
+            const auto& node = graph_.nodes[to];
+            for (int e = node.firstEdge; e < node.firstEdge + node.edgeCount; ++e) {
+                if (graph_.edges[e].skips) continue;
+                auto& from = graph_.framesToEnd[graph_.edges[e].from];
+                from = std::min(from, graph_.framesToEnd[to] + 1);
+            }
+        }
     }
 
     const PhonemeSet& set_;

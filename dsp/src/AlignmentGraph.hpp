@@ -28,6 +28,7 @@ struct AlignmentNode {
 struct AlignmentEdge {
     int from = 0;
     float cost = 0;
+    bool skips = false;  // leaves out words between its ends
 };
 
 struct AlignmentGraph {
@@ -35,6 +36,8 @@ struct AlignmentGraph {
     std::vector<AlignmentEdge> edges;  // grouped by target node
     std::vector<int> reach;            // reach[n]: the furthest node any node ≤ n leads to
     std::vector<float> endCost;        // per node: cost of ending there (+inf: not an end)
+    // per node: the fewest frames a path there needs after this one to say every word left
+    std::vector<int> framesToEnd;
     int words = 0, phones = 0;
     int minimumFrames = 0;       // the shortest path through every word
     double expectedSeconds = 0;  // the synthesiser's durations, times the time scale

@@ -17,6 +17,9 @@ namespace {
 constexpr float kMissingClassDb = 12.0f;
 // In a frame below the energy gate, speech classes count as this much further off (dB).
 constexpr float kSilentExcessDb = 3.0f;
+// The input's expected length in frames is the file's duration over the hop: the analyser's
+// count can differ by its edge frames.
+constexpr std::int64_t kFrameSlack = 2;
 }  // namespace
 
 struct ForcedAligner::State {
@@ -46,6 +49,7 @@ struct ForcedAligner::State {
     void step();
     int ancestor(std::int64_t frame, int node, std::int64_t atFrame) const;
     void commit(std::int64_t keepFrames);
+    int commitFrom() const;
     void emitPath(std::int64_t lastFrame, int node);
     void dropFront(std::int64_t frames);
     float emit(const AlignmentNode& n) const {
@@ -65,6 +69,7 @@ struct ForcedAligner::State {
     std::vector<std::int32_t> back;
     std::vector<float> excess;
     std::int64_t windowStart = 0, frames = 0;
+    std::int64_t totalFrames = -1;  // the input's length, when known (expectFrames)
     std::size_t peakRows = 0;
     bool finished = false;
 };
@@ -195,12 +200,34 @@ void ForcedAligner::State::dropFront(std::int64_t count) {
     windowStart += count;
 }
 
+// The partial path to commit to: the best, counting against each the words it could no longer
+// say in the frames left, at the cost of skipping them, once the input's length is known. A
+// path that fell behind the words can score best for a while (the words it has not reached
+// yet cost nothing so far) and then find no way through the rest.
+int ForcedAligner::State::commitFrom() const {
+    const double left = totalFrames > frames ? double(totalFrames - frames) : 0.0;
+    const double framesPerWord = std::max(1.0, double(graph.minimumFrames) / graph.words);
+    int best = lo;
+    float bestScore = kNever;
+    for (int n = lo; n <= hi; ++n) {
+        if (!(delta[n] < kNever)) continue;
+        float score = delta[n];
+        if (totalFrames >= 0) {
+            const double over = graph.framesToEnd[n] - left - kFrameSlack;
+            if (over > 0) score += config.skipWordCost * float(std::ceil(over / framesPerWord));
+        }
+        if (score < bestScore) {
+            bestScore = score;
+            best = n;
+        }
+    }
+    return best;
+}
+
 void ForcedAligner::State::commit(std::int64_t keepFrames) {
     const std::int64_t last = frames - 1, upTo = last - keepFrames;
     if (upTo < windowStart) return;
-    int bestNode = lo;
-    for (int n = lo; n <= hi; ++n)
-        if (delta[n] < delta[bestNode]) bestNode = n;
+    const int bestNode = commitFrom();
     const int anchor = ancestor(last, bestNode, upTo);
     emitPath(upTo, anchor);
     for (int n = lo; n <= hi; ++n)
@@ -229,6 +256,10 @@ void ForcedAligner::push(double time, std::span<const float> distances, bool sil
     const auto every = static_cast<std::int64_t>(std::lround(s.config.commitSeconds / s.hop));
     if (static_cast<std::int64_t>(s.rows.size()) >= keep + std::max<std::int64_t>(1, every))
         s.commit(keep);
+}
+
+void ForcedAligner::expectFrames(std::int64_t total) {
+    state_->totalFrames = total;
 }
 
 Alignment ForcedAligner::finish() {

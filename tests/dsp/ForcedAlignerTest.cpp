@@ -152,6 +152,41 @@ TEST(ForcedAligner, LongInputIsAlignedInABoundedWindow) {
     for (const auto& w : a.words) ASSERT_TRUE(w.placed) << w.text;
 }
 
+// A slow speaker whose last words sound more like the vowel before them than like themselves
+// (a real voice against templates): before the end, holding that vowel scores best. Committed
+// to it, the path cannot fit the last words in the frames left, and skips them.
+TEST(ForcedAligner, KnowingTheInputsLengthCommitsToAPathThatCanStillSayEveryWord) {
+    const auto& set = PhonemeSet::common();
+    Frames f;
+    f.add({{"sil", 20}});
+    f.add(kMama);
+    for (const auto& runs : {kSee, kWow})
+        for (const auto& r : runs) {
+            std::vector<float> d(set.size(), 10.0f);
+            d[*set.find(r.phoneme)] = 4.5f;
+            d[*set.find("ah")] = 4.0f;
+            for (int i = 0; i < 2 * r.frames; ++i) {
+                f.distances.push_back(d);
+                f.silent.push_back(false);
+            }
+        }
+    f.add({{"sil", 10}});
+    const auto script = mamaSeeWow();
+    AlignerConfig config;
+    config.commitSeconds = 1.4;
+    config.lookaheadSeconds = 0.1;
+    auto placed = [&](bool knowLength) {
+        ForcedAligner aligner(script, set, kHop, 1.0, config);
+        if (knowLength) aligner.expectFrames(static_cast<std::int64_t>(f.distances.size()));
+        const auto a = f.align(script, &aligner);
+        return a.complete && a.words[1].end > a.words[1].start && a.words[2].end > a.words[2].start;
+    };
+    EXPECT_TRUE(placed(true));
+    EXPECT_FALSE(placed(false));  // the case this guards against still arises without it
+    config.commitSeconds = 100;   // no commit before the end: the whole input's best path
+    EXPECT_TRUE(placed(false));
+}
+
 TEST(ForcedAligner, NoFramesMeansNoWordPlacedAndNoCrash) {
     const auto script = mamaSeeWow();
     ForcedAligner aligner(script, PhonemeSet::common(), kHop);

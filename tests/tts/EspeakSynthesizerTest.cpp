@@ -86,6 +86,20 @@ TEST(EspeakSynthesizer, RussianClustersWithRGetNoVowelInTheAlignersWords) {
     EXPECT_EQ(utro[2].phoneme, "r");
 }
 
+// Before a word set off by a dash espeak-ng places the word's event on the dash: the word
+// list of an alignment named it "-" (festvox-ru's "а он - в направлении").
+TEST(EspeakSynthesizer, AWordAfterADashIsNamedNotTheDash) {
+    const auto en = scriptForText(synthesizer(), "a house - in, the town", "en-us",
+                                  espeakMapForVoice("en-us"), nullptr);
+    std::vector<std::string> words;
+    for (const auto& w : en) words.push_back(w.text);
+    EXPECT_EQ(words, (std::vector<std::string>{"a", "house", "in", "the", "town"}));
+    const auto ru = scriptForText(synthesizer(), "а он - в направлении", "ru",
+                                  espeakMapForVoice("ru"), nullptr);
+    ASSERT_EQ(ru.size(), 4u);
+    EXPECT_EQ(ru[2].text, "в");
+}
+
 TEST(EspeakSynthesizer, UnknownVoiceIsAnInputErrorNamingIt) {
     try {
         synthesizer().synthesize({"hello", "xx-nowhere", 0, -1});

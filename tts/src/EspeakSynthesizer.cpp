@@ -103,15 +103,32 @@ bool isSound(const std::string& name) {
     return std::isalnum(first) != 0 || first == '@';
 }
 
+// The word at [from, to) of the text. Before a word set off by a dash ("a house - in the town")
+// espeak-ng places the word's event on the dash; the word is the next one in the text.
+std::string wordAt(const std::string& text, std::size_t from, std::size_t to) {
+    const auto isWordByte = [](char c) {
+        const auto b = static_cast<unsigned char>(c);
+        return b >= 0x80 || std::isalnum(b) != 0;  // any byte of a non-ASCII letter counts
+    };
+    if (from >= to || std::any_of(text.begin() + from, text.begin() + to, isWordByte))
+        return text.substr(from, to - from);
+    const auto isSpace = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+    const auto begin = std::find_if(text.begin() + to, text.end(), isWordByte);
+    if (begin == text.end()) return text.substr(from, to - from);
+    auto end = std::find_if(begin, text.end(), isSpace);
+    while (!isWordByte(*(end - 1))) --end;  // "в," → "в"
+    return std::string(begin, end);
+}
+
 // Each word event owns the phoneme events from it to the next word event; pauses before the
 // first word belong to none.
 std::vector<SpokenWord> spokenWords(const std::string& text, const Collector& c, double total) {
     std::vector<SpokenWord> words;
     for (std::size_t w = 0; w < c.words.size(); ++w) {
         const auto& mark = c.words[w];
-        const auto from = byteOffset(text, mark.position - 1);
-        const auto to = byteOffset(text, mark.position - 1 + mark.length);
-        SpokenWord word{text.substr(from, to - from), {}};
+        SpokenWord word{wordAt(text, byteOffset(text, mark.position - 1),
+                               byteOffset(text, mark.position - 1 + mark.length)),
+                        {}};
         const auto last = w + 1 < c.words.size() ? c.words[w + 1].firstEvent : c.events.size();
         std::size_t shareFrom = 0;  // the segment a run of zero-length phonemes shares
         for (std::size_t i = mark.firstEvent; i < last; ++i) {

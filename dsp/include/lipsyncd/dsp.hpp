@@ -819,7 +819,7 @@ struct Alignment {
 class ForcedAligner {
   public:
     // timeScale: audio durations / synthesiser durations (speech rate), e.g. from
-    // estimateTimeScale(); hopSeconds: the frame hop.
+    // measureSpeechTiming(); hopSeconds: the frame hop.
     ForcedAligner(std::span<const ScriptWord> script, const PhonemeSet& set, double hopSeconds,
                   double timeScale = 1.0, const AlignerConfig& config = {});
     ForcedAligner(ForcedAligner&&) noexcept;
@@ -829,6 +829,12 @@ class ForcedAligner {
     // One frame: its centre time, the classifier's distance to each class (+inf: no template
     // or no spectrum) and whether it is below the energy gate.
     void push(double time, std::span<const float> distances, bool silent);
+    // The input's length in frames, when known before the end (a file). The path is committed
+    // in windows, each time from the best partial path; knowing the length, a commit passes
+    // over partial paths that can no longer fit the rest of the words in the frames left. A
+    // slow speaker's file otherwise could commit to a path that fell behind the words and find
+    // no way through them at the end.
+    void expectFrames(std::int64_t total);
     Alignment finish();
     // The shortest audio the script fits in (minimum durations), seconds.
     double minimumSeconds() const;
@@ -851,11 +857,18 @@ struct AlignFileResult {
     bool fellBack = false;              // the whole file is audio-only analysis
 };
 
-// The synthesiser's durations of the script against the speech found in the file: how much
-// slower (> 1) the speaker is. 1 when the file has no speech.
-double estimateTimeScale(std::span<const ScriptWord> script, const std::filesystem::path& file,
-                         const DecodeOptions& decode = {},
-                         const std::optional<RawFormat>& raw = std::nullopt);
+struct SpeechTiming {
+    // The speech found in the file against the synthesiser's durations of the script: how
+    // much slower (> 1) the speaker is; 1 when the file has no speech.
+    double timeScale = 1;
+    double durationSeconds = 0;  // the whole file's
+};
+
+// One quick pass over the file's levels, before the alignment.
+SpeechTiming measureSpeechTiming(std::span<const ScriptWord> script,
+                                 const std::filesystem::path& file,
+                                 const DecodeOptions& decode = {},
+                                 const std::optional<RawFormat>& raw = std::nullopt);
 
 // Aligns the script on a file, with the audio-only schedule in the stretches the script does
 // not explain and for words not placed. Bad audio (no speech, far too short for the words)
