@@ -111,7 +111,9 @@ void addAlignCommand(CLI::App& app) {
                     "espeak-ng voice whose reading of the words to follow (its language)")
         ->capture_default_str();
     cmd->add_option("--min-word-confidence", o->minWordConfidence,
-                    "Words placed with less confidence get audio-only analysis instead")
+                    "Words placed with less confidence get audio-only analysis; in a line whose "
+                    "median word confidence reaches it, a word needs only 0.4 of that median, and "
+                    "the word of a one-word line 0.1 (never more than this)")
         ->check(CLI::Range(0.0, 1.0))
         ->capture_default_str();
     cmd->add_option("--silence-in-speech-cost", o->silenceInSpeechCost,

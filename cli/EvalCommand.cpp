@@ -409,7 +409,10 @@ void addEvalCommand(CLI::App& app) {
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");
     cmd->add_option("--min-word-confidence", o->aligner.minWordConfidence,
-                    "With --align: words placed with less confidence get audio-only analysis")
+                    "With --align: words placed with less confidence get audio-only analysis; in a "
+                    "line whose "
+                    "median word confidence reaches it, a word needs only 0.4 of that median, and "
+                    "the word of a one-word line 0.1 (never more than this)")
         ->check(CLI::Range(0.0, 1.0))
         ->capture_default_str();
     cmd->add_option("--reduction-cost", o->aligner.reductionCost,

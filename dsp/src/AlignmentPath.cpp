@@ -64,9 +64,25 @@ float AlignmentPath::confidence(std::size_t word) const {
     return static_cast<float>(std::exp(-excess / kExcessScaleDb - 0.5 * logRatio * logRatio));
 }
 
+// A word's confidence alone tells a right word from a wrong one poorly on real voices (the
+// templates fit them less well than espeak-ng's); the line's median tells a script that fits
+// the audio from one that does not far better. In a line that fits, a word is judged against
+// the line: it needs a share of the line's median. A line of one word has no median to go by.
+float AlignmentPath::wordConfidenceFloor(std::vector<float> confidences) const {
+    const float floor = config_.minWordConfidence;
+    if (confidences.size() <= 1) return std::min(floor, config_.minSingleWordConfidence);
+    std::nth_element(confidences.begin(), confidences.begin() + confidences.size() / 2,
+                     confidences.end());
+    const float median = confidences[confidences.size() / 2];
+    return median >= floor ? std::min(floor, config_.fittingLineShare * median) : floor;
+}
+
 Alignment AlignmentPath::finish(bool complete) {
     closeRun();
     out_.complete = complete;
+    std::vector<float> confidences(words_.size());
+    for (std::size_t i = 0; i < words_.size(); ++i) confidences[i] = confidence(i);
+    const float floor = wordConfidenceFloor(confidences);
     for (std::size_t i = 0; i < words_.size(); ++i) {
         AlignedWord w{texts_[i]};
         if (words_[i].frames > 0) {
@@ -76,8 +92,8 @@ Alignment AlignmentPath::finish(bool complete) {
             w.durationRatio = static_cast<float>((w.end - w.start) /
                                                  std::max(hop_, graph_->wordExpectedSeconds[i]));
         }
-        w.confidence = confidence(i);
-        w.placed = words_[i].frames > 0 && w.confidence >= config_.minWordConfidence;
+        w.confidence = confidences[i];
+        w.placed = words_[i].frames > 0 && w.confidence >= floor;
         out_.words.push_back(w);
     }
     // Segments carry their word's confidence; neighbours of one class merge (the classes

@@ -31,6 +31,7 @@ class AlignmentPath {
     };
     void closeRun();
     float confidence(std::size_t word) const;
+    float wordConfidenceFloor(std::vector<float> confidences) const;
 
     const AlignmentGraph* graph_;
     const PhonemeSet* set_;

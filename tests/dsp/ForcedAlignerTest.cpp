@@ -93,6 +93,48 @@ TEST(ForcedAligner, FindsKnownBoundariesExactly) {
     EXPECT_TRUE(a.unexplained.empty());
 }
 
+// Frames of the runs, each `excessDb` further from its own class than from a class no word
+// has (a voice the templates fit less well).
+void addOffTemplate(Frames& f, const std::vector<Run>& runs, float excessDb) {
+    const auto& set = PhonemeSet::common();
+    for (const auto& r : runs) {
+        std::vector<float> d(set.size(), 10.0f);
+        d[*set.find("th")] = 4.0f;
+        d[*set.find(r.phoneme)] = 4.0f + excessDb;
+        for (int i = 0; i < r.frames; ++i) {
+            f.distances.push_back(d);
+            f.silent.push_back(false);
+        }
+    }
+}
+
+// A word's confidence is judged against its line: where every word lies 1.2 dB off (a real
+// voice), a word 2 dB off is still the word; where the others fit, it is not; a one-word line
+// has only a low floor.
+TEST(ForcedAligner, AWordsConfidenceIsJudgedAgainstItsLine) {
+    auto seeIn = [](float othersDb) {
+        Frames f;
+        f.add({{"sil", 20}});
+        addOffTemplate(f, kMama, othersDb);
+        addOffTemplate(f, kSee, 2.0f);
+        addOffTemplate(f, kWow, othersDb);
+        f.add({{"sil", 20}});
+        return f.align(mamaSeeWow()).words[1];
+    };
+    const auto offLine = seeIn(1.2f), fittingLine = seeIn(0.0f);
+    EXPECT_LT(offLine.confidence, AlignerConfig{}.minWordConfidence);
+    EXPECT_TRUE(offLine.placed);
+    EXPECT_NEAR(offLine.confidence, fittingLine.confidence, 0.05);
+    EXPECT_FALSE(fittingLine.placed);
+
+    Frames alone;
+    alone.add({{"sil", 20}});
+    addOffTemplate(alone, kSee, 2.0f);
+    alone.add({{"sil", 20}});
+    const std::vector<ScriptWord> see = {word("see", kSee)};
+    EXPECT_TRUE(alone.align(see).words[0].placed);
+}
+
 TEST(ForcedAligner, AWordTheSpeakerSkippedIsNotPlaced) {
     Frames f;
     f.add({{"sil", 20}});

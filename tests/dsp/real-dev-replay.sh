@@ -8,7 +8,8 @@
 #   real-dev-replay.sh LIPSYNC OUT_DIR SUBSET SPEAKER=GROUP_FLOOR:JAW_FLOOR[:CLOSURES:FALSE]...
 #
 # REPLAY_TEMPLATES=SET scores that template set (a name under config/templates/ or a file)
-# instead of the default one.
+# instead of the default one. REPLAY_ALIGN=1 scores `lipsync align` on each file's words
+# instead (eval --align), festvox-ru read by espeak-ng's ru voice.
 #
 # Exits 77 (ctest: skipped) only when scripts/fetch-real-speech.sh cannot fetch the packages
 # or tools; any other failure fails the test.
@@ -24,12 +25,14 @@ if [ "$rc" -eq 77 ]; then
 fi
 [ "$rc" -eq 0 ] || exit "$rc"
 failed=0
+align=()
+[ -n "${REPLAY_ALIGN:-}" ] && align=(--align --voice festvox-ru-nsh=ru)
 for pair in "$@"; do
   speaker="${pair%%=*}"
   IFS=: read -r group jaw closures falseClosures <<<"${pair#*=}"
-  echo "== $speaker, templates ${REPLAY_TEMPLATES:-default} (floors: visual groups $group, jaw r from audio $jaw," \
+  echo "== $speaker, templates ${REPLAY_TEMPLATES:-default}${align:+, aligned on its words} (floors: visual groups $group, jaw r from audio $jaw," \
     "closures caught ${closures:-0}, false closures at most ${falseClosures:-1})"
-  "$lipsync" eval --corpus "$out/dev/$speaker" --no-per-file --templates "${REPLAY_TEMPLATES:-default}" \
+  "$lipsync" eval --corpus "$out/dev/$speaker" --no-per-file --templates "${REPLAY_TEMPLATES:-default}" "${align[@]}" \
     --min-group-accuracy "$group" \
     --min-jaw-r "$jaw" --min-closures "${closures:-0}" --max-false-closures "${falseClosures:-1}" \
     --min-exact-jaw-r 0.92 --min-exact-closures 0.95 |
