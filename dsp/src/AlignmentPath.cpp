@@ -69,12 +69,12 @@ float AlignmentPath::confidence(std::size_t word) const {
 // the audio from one that does not far better. In a line that fits, a word is judged against
 // the line: it needs a share of the line's median. A line of one word has no median to go by.
 float AlignmentPath::wordConfidenceFloor(std::vector<float> confidences) const {
-    const float floor = config_.minWordConfidence;
-    if (confidences.size() <= 1) return std::min(floor, config_.minSingleWordConfidence);
+    const float strict = config_.minWordConfidence;
+    if (confidences.size() <= 1) return std::min(strict, config_.minSingleWordConfidence);
     std::nth_element(confidences.begin(), confidences.begin() + confidences.size() / 2,
                      confidences.end());
     const float median = confidences[confidences.size() / 2];
-    return median >= floor ? std::min(floor, config_.fittingLineShare * median) : floor;
+    return median >= strict ? std::min(strict, config_.fittingLineShare * median) : strict;
 }
 
 Alignment AlignmentPath::finish(bool complete) {
@@ -82,7 +82,7 @@ Alignment AlignmentPath::finish(bool complete) {
     out_.complete = complete;
     std::vector<float> confidences(words_.size());
     for (std::size_t i = 0; i < words_.size(); ++i) confidences[i] = confidence(i);
-    const float floor = wordConfidenceFloor(confidences);
+    const float minConfidence = wordConfidenceFloor(confidences);
     for (std::size_t i = 0; i < words_.size(); ++i) {
         AlignedWord w{texts_[i]};
         if (words_[i].frames > 0) {
@@ -93,7 +93,7 @@ Alignment AlignmentPath::finish(bool complete) {
                                                  std::max(hop_, graph_->wordExpectedSeconds[i]));
         }
         w.confidence = confidences[i];
-        w.placed = words_[i].frames > 0 && w.confidence >= floor;
+        w.placed = words_[i].frames > 0 && w.confidence >= minConfidence;
         out_.words.push_back(w);
     }
     // Segments carry their word's confidence; neighbours of one class merge (the classes
