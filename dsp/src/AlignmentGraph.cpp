@@ -178,12 +178,13 @@ class GraphBuilder {
     }
 
     // Backwards over the nodes (every edge goes forward): a node's successors are done first.
+    // A path ends having said every word in the last word's unit (its end, the gap after it).
     void countFramesToEnd() {
         const int n = static_cast<int>(graph_.nodes.size());
         constexpr int kUnreachable = std::numeric_limits<int>::max() / 2;
         graph_.framesToEnd.assign(n, kUnreachable);
+        for (int node : units_.back()) graph_.framesToEnd[node] = 0;
         for (int to = n - 1; to >= 0; --to) {
-            if (graph_.endCost[to] == 0) graph_.framesToEnd[to] = 0;  // after the last word
             const auto& node = graph_.nodes[to];
             for (int e = node.firstEdge; e < node.firstEdge + node.edgeCount; ++e) {
                 if (graph_.edges[e].skips) continue;
