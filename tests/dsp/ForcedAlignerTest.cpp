@@ -93,13 +93,14 @@ TEST(ForcedAligner, FindsKnownBoundariesExactly) {
     EXPECT_TRUE(a.unexplained.empty());
 }
 
-// Frames of the runs, each `excessDb` further from its own class than from a class no word
-// has (a voice the templates fit less well).
-void addOffTemplate(Frames& f, const std::vector<Run>& runs, float excessDb) {
+// Frames of the runs, each `excessDb` further from its own class than from `nearest` (by
+// default a class no word has: a voice the templates fit less well).
+void addOffTemplate(Frames& f, const std::vector<Run>& runs, float excessDb,
+                    const std::string& nearest = "th") {
     const auto& set = PhonemeSet::common();
     for (const auto& r : runs) {
         std::vector<float> d(set.size(), 10.0f);
-        d[*set.find("th")] = 4.0f;
+        d[*set.find(nearest)] = 4.0f;
         d[*set.find(r.phoneme)] = 4.0f + excessDb;
         for (int i = 0; i < r.frames; ++i) {
             f.distances.push_back(d);
@@ -202,16 +203,10 @@ TEST(ForcedAligner, KnowingTheInputsLengthCommitsToAPathThatCanStillSayEveryWord
     Frames f;
     f.add({{"sil", 20}});
     f.add(kMama);
+    std::vector<dsp::Run> slowSeeWow;  // twice as long as the script's "see wow"
     for (const auto& runs : {kSee, kWow})
-        for (const auto& r : runs) {
-            std::vector<float> d(set.size(), 10.0f);
-            d[*set.find(r.phoneme)] = 4.5f;
-            d[*set.find("ah")] = 4.0f;
-            for (int i = 0; i < 2 * r.frames; ++i) {
-                f.distances.push_back(d);
-                f.silent.push_back(false);
-            }
-        }
+        for (const auto& r : runs) slowSeeWow.push_back({r.phoneme, 2 * r.frames});
+    addOffTemplate(f, slowSeeWow, 0.5f, "ah");
     f.add({{"sil", 10}});
     const auto script = mamaSeeWow();
     AlignerConfig config;
