@@ -62,6 +62,8 @@ class GraphBuilder {
         AlignmentNode filler{AlignmentNode::Kind::Filler};
         filler.word = gap;
         filler.loopCost = 0;  // its cost is per frame, in the emission
+        const bool after = gap == graph_.words;
+        filler.frameCost = after ? config_.edgeFillerCostPerFrame : config_.fillerCostPerFrame;
         const int first = add(pause);
         int last = first;
         for (int k = 1; k < pauseFrames; ++k) {
@@ -73,6 +75,7 @@ class GraphBuilder {
         const int f = add(filler);
         // The unit a gap ends is the word before it (or the start): both join it.
         const std::size_t unit = units_.size() - 1;
+        const std::vector<int> wordEnds = units_[unit];
         for (int node : {first, f}) {
             const float enter = node == first && inner ? config_.pauseCost : 0.0f;
             for (int from : units_[unit]) edge(from, node, enter);
@@ -82,6 +85,32 @@ class GraphBuilder {
         }
         edge(last, f, 0);  // a pause, then something else; edges only go forward
         units_.back().push_back(last);
+        units_.back().push_back(f);
+        if (after) addFillerAfterPause(wordEnds, pause, filler);
+    }
+
+    // After the last word, sound straight after its last phoneme is more likely that phoneme
+    // going on (a final fricative or vowel held long) than something else, but after a pause
+    // of at least minPauseSeconds, something else (music, the next sound of the show) is
+    // likelier: a second filler, cheaper per frame, entered only through such a pause.
+    void addFillerAfterPause(const std::vector<int>& wordEnds, const AlignmentNode& pause,
+                             AlignmentNode filler) {
+        const int frames =
+            std::max(1, static_cast<int>(std::lround(config_.minPauseSeconds / hop_)));
+        int last = -1;
+        AlignmentNode silent = pause;
+        silent.silentOnly = true;  // a pause heard, not a quiet end of the phoneme taken for one
+        for (int k = 0; k < frames; ++k) {
+            const int n = add(silent);
+            if (last >= 0)
+                edge(last, n, 0);
+            else
+                for (int from : wordEnds) edge(from, n, 0);
+            last = n;
+        }
+        filler.frameCost = config_.fillerAfterPauseCostPerFrame;
+        const int f = add(filler);
+        edge(last, f, 0);
         units_.back().push_back(f);
     }
 

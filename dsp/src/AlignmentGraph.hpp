@@ -21,6 +21,8 @@ struct AlignmentNode {
     int word = -1;    // word index (Phoneme) or the gap's index (Pause, Filler: before word)
     int phone = -1;   // running index of the phoneme in the script (Phoneme)
     float loopCost = kNever;           // staying another frame
+    float frameCost = 0;               // Filler: its cost per frame (AlignerConfig)
+    bool silentOnly = false;           // Pause: only on frames below the energy gate
     float exitCost = 0;                // leaving (the tail's end probability)
     int firstEdge = 0, edgeCount = 0;  // incoming edges
 };

@@ -53,9 +53,8 @@ struct ForcedAligner::State {
     void emitPath(std::int64_t lastFrame, int node);
     void dropFront(std::int64_t frames);
     float emit(const AlignmentNode& n) const {
-        if (n.kind != AlignmentNode::Kind::Filler) return emission[n.phoneme];
-        const bool after = n.word == graph.words;  // after the last word
-        return after ? config.edgeFillerCostPerFrame : config.fillerCostPerFrame;
+        if (n.kind == AlignmentNode::Kind::Filler) return n.frameCost;
+        return n.silentOnly && !frameSilent ? kNever : emission[n.phoneme];
     }
 
     AlignmentGraph graph;
@@ -64,7 +63,8 @@ struct ForcedAligner::State {
     AlignerConfig config;
     AlignmentPath path;
     std::vector<float> delta, next, emission;
-    int lo = 0, hi = 0;  // active nodes after the last frame
+    bool frameSilent = false;  // the frame being scored is below the energy gate
+    int lo = 0, hi = 0;        // active nodes after the last frame
     std::vector<Row> rows;
     std::vector<std::int32_t> back;
     std::vector<float> excess;
@@ -76,6 +76,7 @@ struct ForcedAligner::State {
 
 void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool silent,
                                       std::vector<float>& excessOut) {
+    frameSilent = silent;
     const std::size_t classes = set->size();
     float nearest = kNever;
     for (std::size_t c = 0; c < classes && c < distances.size(); ++c)

@@ -3,6 +3,7 @@
 // bounded window of frames however long the input.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
@@ -134,6 +135,62 @@ TEST(ForcedAligner, AWordsConfidenceIsJudgedAgainstItsLine) {
     alone.add({{"sil", 20}});
     const std::vector<ScriptWord> see = {word("see", kSee)};
     EXPECT_TRUE(alone.align(see).words[0].placed);
+}
+
+// A word said alone often ends in a long vowel or fricative that the templates fit less well:
+// straight after the last phoneme it is that phoneme held on. After a pause, sound like it is
+// something else (music after the line) and is left unexplained.
+TEST(ForcedAligner, ALastPhonemeHeldLongStaysWithTheWordButSoundAfterAPauseDoesNot) {
+    auto align = [&](const std::vector<ScriptWord>& script, const Frames& f,
+                     const AlignerConfig& config) {
+        ForcedAligner a(script, PhonemeSet::common(), kHop, 1.0, config);
+        for (std::size_t i = 0; i < f.distances.size(); ++i)
+            a.push((i + 0.5) * kHop, f.distances[i], f.silent[i]);
+        return a.finish();
+    };
+    // 2.3 dB off with the nearest 4 dB away: 0.7 a frame at the default distance weight,
+    // between the two edge fillers' costs.
+    Frames held;
+    held.add({{"sil", 20}});
+    held.add(kSee);
+    addOffTemplate(held, {{"ih", 15}}, 2.3f);
+    const double heldEnd = held.distances.size() * kHop;
+    held.add({{"sil", 3}});  // the clip cut close
+    const std::vector<ScriptWord> see = {word("see", kSee)};
+    const auto a = align(see, held, {});
+    ASSERT_TRUE(a.words[0].placed);
+    EXPECT_NEAR(a.words[0].end, heldEnd, 0.0101);
+    EXPECT_TRUE(a.unexplained.empty());
+    AlignerConfig oneCost;  // one cheap filler after the line, pause or not: the tail is lost
+    oneCost.edgeFillerCostPerFrame = oneCost.fillerAfterPauseCostPerFrame;
+    EXPECT_LT(align(see, held, oneCost).words[0].end, heldEnd - 0.1);
+
+    // A consonant may run on through a pause (a stop's closure is silent), so without the
+    // filler after a pause the music would be the word's last /z/.
+    const std::vector<dsp::Run> is = {{"ih", 10}, {"z", 10}};
+    Frames paused;
+    paused.add({{"sil", 20}});
+    paused.add(is);
+    const double isEnd = paused.distances.size() * kHop;
+    for (int i = 0; i < 10; ++i) {  // digital silence between the line and the music
+        paused.distances.emplace_back(PhonemeSet::common().size(),
+                                      std::numeric_limits<float>::infinity());
+        paused.silent.push_back(true);
+    }
+    const double musicFrom = paused.distances.size() * kHop;
+    addOffTemplate(paused, {{"z", 60}}, 2.3f);
+    paused.add({{"sil", 20}});
+    const std::vector<ScriptWord> script = {word("is", is)};
+    const auto b = align(script, paused, {});
+    ASSERT_TRUE(b.words[0].placed);
+    EXPECT_NEAR(b.words[0].end, isEnd, 0.0101);
+    ASSERT_EQ(b.unexplained.size(), 1u);  // from within the pause, on to the end
+    EXPECT_GE(b.unexplained[0].first, isEnd);
+    EXPECT_LE(b.unexplained[0].first, musicFrom);
+    EXPECT_GE(b.unexplained[0].second, musicFrom + 0.6);
+    AlignerConfig noPause;  // one dear filler after the line: the word takes the music in
+    noPause.fillerAfterPauseCostPerFrame = noPause.edgeFillerCostPerFrame;
+    EXPECT_GT(align(script, paused, noPause).words[0].end, musicFrom + 0.3);
 }
 
 TEST(ForcedAligner, AWordTheSpeakerSkippedIsNotPlaced) {
