@@ -1,5 +1,6 @@
 // The state graph of a forced alignment: a start node; then, for every gap between words (and
-// before the first and after the last), an optional pause and an optional filler; and for every
+// before the first and after the last), an optional pause and an optional filler (after the
+// last word two fillers: one straight after it, one only after a pause heard); and for every
 // phoneme of every word a chain of minimum-duration nodes, the last with a self-loop whose
 // probability gives the expected duration (a geometric tail; Rabiner 1989, section IV.D). A word
 // said more than one way (reductions) has one such run of chains per pronunciation, in parallel.
