@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace lipsyncd::dsp {
 
@@ -54,8 +55,6 @@ class GraphBuilder {
         // Silence before and after the words is expected; between them it costs, and it lasts:
         // a stop's closure at a word boundary is silent too, but short, and part of the stop.
         const bool inner = gap > 0 && gap < graph_.words;
-        const int pauseFrames =
-            inner ? std::max(1, static_cast<int>(std::lround(config_.minPauseSeconds / hop_))) : 1;
         AlignmentNode pause{AlignmentNode::Kind::Pause};
         pause.phoneme = static_cast<int>(set_.silence());
         pause.word = gap;
@@ -64,18 +63,11 @@ class GraphBuilder {
         filler.loopCost = 0;  // its cost is per frame, in the emission
         const bool after = gap == graph_.words;
         filler.frameCost = after ? config_.edgeFillerCostPerFrame : config_.fillerCostPerFrame;
-        const int first = add(pause);
-        int last = first;
-        for (int k = 1; k < pauseFrames; ++k) {
-            const int n = add(pause);
-            edge(last, n, 0);
-            last = n;
-        }
+        const auto [first, last] = addChainOf(pause, inner ? minPauseFrames() : 1);
         graph_.nodes[last].loopCost = config_.silenceLoopCost;
         const int f = add(filler);
         // The unit a gap ends is the word before it (or the start): both join it.
         const std::size_t unit = units_.size() - 1;
-        const std::vector<int> wordEnds = units_[unit];
         for (int node : {first, f}) {
             const float enter = node == first && inner ? config_.pauseCost : 0.0f;
             for (int from : units_[unit]) edge(from, node, enter);
@@ -84,34 +76,43 @@ class GraphBuilder {
                     edge(from, node, enter + config_.skipWordCost * static_cast<float>(s), true);
         }
         edge(last, f, 0);  // a pause, then something else; edges only go forward
+        const int afterPause = after ? addFillerAfterPause(units_[unit], pause, filler) : -1;
         units_.back().push_back(last);
         units_.back().push_back(f);
-        if (after) addFillerAfterPause(wordEnds, pause, filler);
+        if (afterPause >= 0) units_.back().push_back(afterPause);
+    }
+
+    int minPauseFrames() const {
+        return std::max(1, static_cast<int>(std::lround(config_.minPauseSeconds / hop_)));
+    }
+
+    // `frames` copies of `node` in a row, each entered from the one before: {first, last}.
+    std::pair<int, int> addChainOf(const AlignmentNode& node, int frames) {
+        const int first = add(node);
+        int last = first;
+        for (int k = 1; k < frames; ++k) {
+            const int n = add(node);
+            edge(last, n, 0);
+            last = n;
+        }
+        return {first, last};
     }
 
     // After the last word, sound straight after its last phoneme is more likely that phoneme
     // going on (a final fricative or vowel held long) than something else, but after a pause
     // of at least minPauseSeconds, something else (music, the next sound of the show) is
-    // likelier: a second filler, cheaper per frame, entered only through such a pause.
-    void addFillerAfterPause(const std::vector<int>& wordEnds, const AlignmentNode& pause,
-                             AlignmentNode filler) {
-        const int frames =
-            std::max(1, static_cast<int>(std::lround(config_.minPauseSeconds / hop_)));
-        int last = -1;
+    // likelier: a second filler, cheaper per frame, entered only through such a pause. Returns
+    // that filler's node.
+    int addFillerAfterPause(const std::vector<int>& wordEnds, const AlignmentNode& pause,
+                            AlignmentNode filler) {
         AlignmentNode silent = pause;
         silent.silentOnly = true;  // a pause heard, not a quiet end of the phoneme taken for one
-        for (int k = 0; k < frames; ++k) {
-            const int n = add(silent);
-            if (last >= 0)
-                edge(last, n, 0);
-            else
-                for (int from : wordEnds) edge(from, n, 0);
-            last = n;
-        }
+        const auto [first, last] = addChainOf(silent, minPauseFrames());
+        for (int from : wordEnds) edge(from, first, 0);
         filler.frameCost = config_.fillerAfterPauseCostPerFrame;
         const int f = add(filler);
         edge(last, f, 0);
-        units_.back().push_back(f);
+        return f;
     }
 
     // A word: a chain per pronunciation, side by side (each entered from the unit before and
