@@ -27,6 +27,7 @@ struct AlignOptions {
     std::string format = "tsv";
     float minWordConfidence = dsp::AlignerConfig{}.minWordConfidence;
     float silenceInSpeechCost = dsp::AlignerConfig{}.silenceInSpeechCost;
+    float secondPassPrior = dsp::AlignerConfig{}.fileAdaptationPriorFrames;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
     bool quiet = false, reductions = true;
@@ -65,6 +66,7 @@ void runAlign(const AlignOptions& o) {
     dsp::AlignerConfig aligner;
     aligner.minWordConfidence = o.minWordConfidence;
     aligner.silenceInSpeechCost = o.silenceInSpeechCost;
+    aligner.fileAdaptationPriorFrames = o.secondPassPrior;
     EspeakSynthesizer synth;
     const auto r = alignText(synth, o.input, text, o.voice, templates, o.frontEnd.config(), aligner,
                              o.frontEnd.decode(), o.frontEnd.raw(), o.reductions);
@@ -119,6 +121,11 @@ void addAlignCommand(CLI::App& app) {
     cmd->add_option("--silence-in-speech-cost", o->silenceInSpeechCost,
                     "Cost per frame of silence where the energy gate hears speech")
         ->check(CLI::Range(0.0, 100.0))
+        ->capture_default_str();
+    cmd->add_option("--second-pass-prior", o->secondPassPrior,
+                    "Align a second time on templates moved toward the file's own voice (what the "
+                    "first pass placed); the templates weigh as this many frames (0: one pass)")
+        ->check(CLI::Range(0.0, 1000.0))
         ->capture_default_str();
     cmd->add_flag("!--no-reductions", o->reductions,
                   "Follow espeak-ng's reading only, without the common reductions "

@@ -423,6 +423,11 @@ void addEvalCommand(CLI::App& app) {
                     "With --align: cost per frame of silence where the energy gate hears speech")
         ->check(CLI::Range(0.0, 100.0))
         ->capture_default_str();
+    cmd->add_option("--second-pass-prior", o->aligner.fileAdaptationPriorFrames,
+                    "With --align: align a second time on templates moved toward the file's own "
+                    "voice; the templates weigh as this many frames (0: one pass)")
+        ->check(CLI::Range(0.0, 1000.0))
+        ->capture_default_str();
     cmd->add_flag("!--no-reductions", o->reductions,
                   "With --align: follow espeak-ng's reading only, without the common reductions "
                   "(config/reductions/LANG.toml)");

@@ -153,21 +153,98 @@ SpeechTiming measureSpeechTiming(std::span<const ScriptWord> script,
     return timing;
 }
 
+// The segments of the words placed: what a voice's own templates may learn from. Stretches no
+// word explains and words below the confidence floor are left out, so a wrong script teaches
+// little.
+PhonemeSchedule placedSegments(const Alignment& a) {
+    PhonemeSchedule placed;
+    std::size_t w = 0;
+    for (const auto& seg : a.schedule) {
+        while (w < a.words.size() && (!a.words[w].placed || a.words[w].end <= seg.start)) ++w;
+        if (w == a.words.size()) break;
+        if (seg.start >= a.words[w].start - 1e-6 && seg.end <= a.words[w].end + 1e-6)
+            placed.push_back(seg);
+    }
+    return placed;
+}
+
+// The frames a second pass needs (FrameClassifier::classify's inputs), up to a bound (about
+// 440 bytes a frame: 13 MB for AlignerConfig::fileAdaptationMaxSeconds).
+class KeptFrames {
+  public:
+    explicit KeptFrames(std::size_t limit) : limit_(limit) {}
+    void add(const FrameFeatures& frame, bool silent) {
+        if (frames_.size() >= limit_) {
+            overflow_ = true;
+            return;
+        }
+        frames_.push_back(frame);
+        silent_.push_back(silent);
+    }
+    bool complete() const { return limit_ > 0 && !overflow_; }
+    std::span<const FrameFeatures> frames() const { return frames_; }
+    std::span<const std::uint8_t> silent() const { return silent_; }  // below the energy gate
+
+  private:
+    std::size_t limit_;
+    bool overflow_ = false;
+    std::vector<FrameFeatures> frames_;
+    std::vector<std::uint8_t> silent_;
+};
+
+// The second pass (AlignerConfig::fileAdaptationPriorFrames, Gauvain & Lee 1994): the file's
+// frames again, on templates moved toward what the first pass placed. The first pass's verdict
+// on each word stands: a word it left unplaced stays so, whatever the moved templates say (they
+// learnt from the placed words only, and would fit a wrong script better the second time).
+Alignment realign(const Alignment& first, const SpeakerAdaptation& own,
+                  std::span<const FrameFeatures> frames, std::span<const ScriptWord> script,
+                  const PhonemeSet& set, const ClassifierConfig& classifierConfig,
+                  const AlignerConfig& config, double timeScale) {
+    auto adapted = own.adapted(config.fileAdaptationPriorFrames);
+    adapted.jawNetwork.reset();  // neither the heard jaw nor the class network is used here
+    adapted.classNetwork.reset();
+    FrameClassifier classifier(adapted, set, classifierConfig);
+    ForcedAligner aligner(script, set, adapted.analysis.hopSeconds, timeScale, config);
+    aligner.expectFrames(static_cast<std::int64_t>(frames.size()));
+    for (const auto& frame : frames) {
+        const auto label = classifier.classify(frame);
+        aligner.push(label.time, classifier.distances(), label.silent);
+    }
+    auto second = aligner.finish();
+    if (!second.complete || second.words.size() != first.words.size()) return first;
+    for (std::size_t i = 0; i < second.words.size(); ++i)
+        second.words[i].placed = second.words[i].placed && first.words[i].placed;
+    return second;
+}
+
 AlignFileResult alignFile(const std::filesystem::path& file, std::span<const ScriptWord> script,
                           const TemplateSet& templates, const PhonemeSet& set,
                           const FrontEndConfig& config, const AlignerConfig& alignerConfig,
-                          const DecodeOptions& decode, const std::optional<RawFormat>& raw) {
+                          const DecodeOptions& decode, const std::optional<RawFormat>& raw,
+                          SpeakerAdaptation* speaker) {
     AlignFileResult r;
     SpeechTiming timing;
     if (file != "-") timing = measureSpeechTiming(script, file, decode, raw);
     r.timeScale = timing.timeScale;
     auto decoder = AudioDecoder::open(file, decode, raw);
-    StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
-    ForcedAligner aligner(script, set, templates.analysis.hopSeconds, r.timeScale, alignerConfig);
+    // A speaker carried from line to line: this line starts from the voice heard so far.
+    const TemplateSet& base = speaker ? speaker->base() : templates;
+    const auto start =
+        speaker && speaker->frames() > 0
+            ? std::optional(speaker->adapted(alignerConfig.speakerAdaptationPriorFrames))
+            : std::nullopt;
+    const TemplateSet& first = start ? *start : base;
+    StreamingAnalyzer analyzer(first, set, decoder.sampleRate(), config);
+    ForcedAligner aligner(script, set, first.analysis.hopSeconds, r.timeScale, alignerConfig);
     if (timing.durationSeconds > 0)
-        aligner.expectFrames(std::llround(timing.durationSeconds / templates.analysis.hopSeconds));
+        aligner.expectFrames(std::llround(timing.durationSeconds / first.analysis.hopSeconds));
+    const bool adapting = alignerConfig.fileAdaptationPriorFrames > 0 || speaker;
+    KeptFrames kept(adapting ? static_cast<std::size_t>(alignerConfig.fileAdaptationMaxSeconds /
+                                                        first.analysis.hopSeconds)
+                             : 0);
     std::size_t speechFrames = 0;
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
+        if (adapting) kept.add(f.features, f.label.silent);
         aligner.push(f.label.time, analyzer.templateDistances(), f.label.silent);
         speechFrames += !f.label.silent;
         r.levels.add(f.label.time, f.label.energyDb);
@@ -184,7 +261,15 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     r.durationSeconds = static_cast<double>(total) / decoder.sampleRate();
     if (!r.audioOnly.empty()) r.audioOnly.back().end = r.durationSeconds;
     r.alignment = aligner.finish();
-    r.levels.rate = 1 / templates.analysis.hopSeconds;
+    r.levels.rate = 1 / first.analysis.hopSeconds;
+    if (r.alignment.complete && kept.complete()) {
+        SpeakerAdaptation own(base);
+        if (speaker) own.add(*speaker);
+        own.add(kept.frames(), placedSegments(r.alignment), kept.silent());
+        if (alignerConfig.fileAdaptationPriorFrames > 0)
+            r.alignment = realign(r.alignment, own, kept.frames(), script, set, config.classifier,
+                                  alignerConfig, r.timeScale);
+    }
 
     const std::string name = decoder.name();
     if (speechFrames == 0) {
@@ -205,6 +290,8 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
         r.schedule = r.audioOnly;
         return r;
     }
+    if (speaker && kept.complete())
+        speaker->add(kept.frames(), placedSegments(r.alignment), kept.silent());
     warnAboutWords(r);
     r.levels.aligned = true;  // (an audio-only fallback keeps the audio-only share)
     r.schedule = r.alignment.schedule;

@@ -1,0 +1,83 @@
+// A speaker's own class means (SpeakerAdaptation): the MAP estimate of each template from the
+// frames of its class nearest to it, and what it must leave alone.
+#include <gtest/gtest.h>
+
+#include <lipsyncd/dsp.hpp>
+
+namespace lipsyncd::dsp {
+namespace {
+
+// Two features; class "ah" with templates at (0, 0) and (10, 10), class "d" with one at (-5, 5).
+TemplateSet twoClasses() {
+    TemplateSet t;
+    t.analysis.spectrumBins = 2;
+    t.binWeights = {1, 1};
+    t.classes = {{"ah", {{0, 0}, {10, 10}}, 100}, {"d", {{-5, 5}}, 100}};
+    return t;
+}
+
+FrameFeatures frame(double time, float a, float b) {
+    FrameFeatures f;
+    f.time = time;
+    f.valid = true;
+    f.spectrum = {a, b};
+    return f;
+}
+
+// Frames every 10 ms from 0.005 s, each at `value`.
+std::vector<FrameFeatures> frames(int count, float a, float b) {
+    std::vector<FrameFeatures> out;
+    for (int i = 0; i < count; ++i) out.push_back(frame(0.005 + 0.01 * i, a, b));
+    return out;
+}
+
+TEST(SpeakerAdaptation, EachTemplateMovesTowardItsNearestFramesByTheirShareOfThePrior) {
+    SpeakerAdaptation adaptation(twoClasses());
+    // Six frames of "ah" near its second template; the first and last are edge frames.
+    adaptation.add(frames(6, 12, 8), {{0.0, 0.06, "ah"}});
+    EXPECT_EQ(adaptation.frames(), 4u);
+    const auto moved = adaptation.adapted(4);
+    // (τ·t + Σx) / (τ + n) with τ = 4, n = 4: halfway from (10, 10) to (12, 8).
+    EXPECT_FLOAT_EQ(moved.classes[0].spectra[1][0], 11.0f);
+    EXPECT_FLOAT_EQ(moved.classes[0].spectra[1][1], 9.0f);
+    // The template no frame was nearest to, and the class not heard, stay.
+    EXPECT_EQ(moved.classes[0].spectra[0], (std::vector<float>{0, 0}));
+    EXPECT_EQ(moved.classes[1].spectra[0], (std::vector<float>{-5, 5}));
+    // No prior: the frames' own mean. A prior far larger than the frames: the base.
+    EXPECT_FLOAT_EQ(adaptation.adapted(0).classes[0].spectra[1][0], 12.0f);
+    EXPECT_NEAR(adaptation.adapted(1e6f).classes[0].spectra[1][0], 10.0f, 1e-4);
+}
+
+TEST(SpeakerAdaptation, SilenceQuietFramesInvalidFramesAndShortSegmentsTeachNothing) {
+    SpeakerAdaptation adaptation(twoClasses());
+    auto f = frames(12, 12, 8);
+    f[3].valid = false;  // digital silence
+    const std::vector<std::uint8_t> silent = {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0};  // a closure
+    adaptation.add(f,
+                   {{0.0, 0.06, "ah"},     // frames 0..5: 1..4 inside, 2 quiet, 3 invalid
+                    {0.06, 0.08, "d"},     // two frames: both edges
+                    {0.08, 0.12, "sil"}},  // silence is not a class to learn
+                   silent);
+    EXPECT_EQ(adaptation.frames(), 2u);  // frames 1 and 4
+    EXPECT_EQ(adaptation.adapted(0).classes[1].spectra[0], (std::vector<float>{-5, 5}));
+}
+
+TEST(SpeakerAdaptation, FramesAreAssignedAgainstTheBaseSoOrderDoesNotMatter) {
+    const auto a1 = frames(5, 6, 6), a2 = frames(5, 4, 4);  // nearer (10, 10), nearer (0, 0)
+    SpeakerAdaptation one(twoClasses()), other(twoClasses());
+    one.add(a1, {{0.0, 0.05, "ah"}});
+    one.add(a2, {{0.0, 0.05, "ah"}});
+    other.add(a2, {{0.0, 0.05, "ah"}});
+    other.add(a1, {{0.0, 0.05, "ah"}});
+    EXPECT_EQ(one.adapted(2).classes[0].spectra, other.adapted(2).classes[0].spectra);
+    // Merging another's frames is the same as hearing them.
+    SpeakerAdaptation first(twoClasses()), second(twoClasses());
+    first.add(a1, {{0.0, 0.05, "ah"}});
+    second.add(a2, {{0.0, 0.05, "ah"}});
+    first.add(second);
+    EXPECT_EQ(first.frames(), one.frames());
+    EXPECT_EQ(first.adapted(2).classes[0].spectra, one.adapted(2).classes[0].spectra);
+}
+
+}  // namespace
+}  // namespace lipsyncd::dsp
