@@ -32,7 +32,7 @@ struct EvalOptions {
     // --align: each NAME.wav is aligned on the words of NAME.txt beside it (lipsync align)
     // instead of analysed from the audio alone; voices: "VOICE" for every speaker, or
     // "SPEAKER=VOICE" for one.
-    bool align = false, reductions = true;
+    bool align = false, reductions = true, adaptSpeaker = false;
     dsp::AlignerConfig aligner;
     std::vector<std::string> voices;
     FrontEndOptions frontEnd;
@@ -68,6 +68,8 @@ struct Evaluator {
     lipsync::Runtime runtime = o.runtime.load();
     std::optional<PuppetJaw> puppet;
     std::unique_ptr<EspeakSynthesizer> synth;  // --align: reads the words
+    // --adapt-speaker: each speaker's voice so far, carried from file to file.
+    mutable std::map<std::string, dsp::SpeakerAdaptation> speakers;
 
     explicit Evaluator(const EvalOptions& options) : o(options) {
         if (o.jaw) puppet.emplace(output::Puppet::named(o.puppet), o.jawActuator);
@@ -131,9 +133,11 @@ struct Evaluator {
                                       o.frontEnd.decode(), std::nullopt);
             return {std::move(a.schedule), std::move(a.levels)};
         }
+        dsp::SpeakerAdaptation* speaker = nullptr;
+        if (o.adaptSpeaker) speaker = &speakers.try_emplace(item.speaker, templates).first->second;
         auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
                            voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner,
-                           o.frontEnd.decode(), std::nullopt, o.reductions);
+                           o.frontEnd.decode(), std::nullopt, o.reductions, speaker);
         for (const auto& w : r.warnings)
             std::cerr << "lipsync eval: " << item.speaker << '/' << item.name << ": " << w << '\n';
         return {std::move(r.schedule), std::move(r.levels)};
@@ -428,6 +432,10 @@ void addEvalCommand(CLI::App& app) {
                     "voice; the templates weigh as this many frames (0: one pass)")
         ->check(CLI::Range(0.0, 1000.0))
         ->capture_default_str();
+    cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
+                  "With --align: carry each speaker's voice from file to file, in name order, as "
+                  "over a show's lines: each file starts from templates moved toward the frames "
+                  "placed in that speaker's earlier files");
     cmd->add_flag("!--no-reductions", o->reductions,
                   "With --align: follow espeak-ng's reading only, without the common reductions "
                   "(config/reductions/LANG.toml)");

@@ -115,13 +115,15 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
                                const dsp::TemplateSet& templates,
                                const dsp::FrontEndConfig& frontEnd,
                                const dsp::AlignerConfig& aligner, const dsp::DecodeOptions& decode,
-                               const std::optional<dsp::RawFormat>& raw, bool reductions) {
+                               const std::optional<dsp::RawFormat>& raw, bool reductions,
+                               dsp::SpeakerAdaptation* speaker) {
     const auto map = espeakMapForVoice(voice);
     const auto& set = PhonemeSet::named(map.phonemeSet());
     std::vector<std::string> warnings;
     const auto weakForms = reductions ? Reductions::forVoice(voice, map) : Reductions{};
     const auto script = scriptForText(synth, text, voice, map, &warnings, &weakForms);
-    auto result = dsp::alignFile(audio, script, templates, set, frontEnd, aligner, decode, raw);
+    auto result =
+        dsp::alignFile(audio, script, templates, set, frontEnd, aligner, decode, raw, speaker);
     result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
     return result;
 }

@@ -104,7 +104,8 @@ std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::
 
 // Aligns `text` on the speech in `audio` with the voice's phoneme map and the given front end;
 // the result says which words were placed and where the audio-only analysis stands in.
-// `reductions`: try the language's common reductions too (Reductions::forVoice).
+// `reductions`: try the language's common reductions too (Reductions::forVoice). `speaker`: one
+// speaker's voice carried from line to line (dsp::alignFile).
 dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                const std::string& text, const std::string& voice,
                                const dsp::TemplateSet& templates,
@@ -112,7 +113,7 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
                                const dsp::AlignerConfig& aligner = {},
                                const dsp::DecodeOptions& decode = {},
                                const std::optional<dsp::RawFormat>& raw = std::nullopt,
-                               bool reductions = true);
+                               bool reductions = true, dsp::SpeakerAdaptation* speaker = nullptr);
 
 // The schedule of an audio file about to be played: aligned on `text` when given, else on the
 // words of a `FILE.txt` beside `FILE.wav` when there is one, else the audio-only analysis. Text
