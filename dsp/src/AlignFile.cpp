@@ -262,13 +262,12 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     if (!r.audioOnly.empty()) r.audioOnly.back().end = r.durationSeconds;
     r.alignment = aligner.finish();
     r.levels.rate = 1 / first.analysis.hopSeconds;
-    if (r.alignment.complete && kept.complete()) {
+    if (alignerConfig.fileAdaptationPriorFrames > 0 && r.alignment.complete && kept.complete()) {
         SpeakerAdaptation own(base);
         if (speaker) own.add(*speaker);
         own.add(kept.frames(), placedSegments(r.alignment), kept.silent());
-        if (alignerConfig.fileAdaptationPriorFrames > 0)
-            r.alignment = realign(r.alignment, own, kept.frames(), script, set, config.classifier,
-                                  alignerConfig, r.timeScale);
+        r.alignment = realign(r.alignment, own, kept.frames(), script, set, config.classifier,
+                              alignerConfig, r.timeScale);
     }
 
     const std::string name = decoder.name();

@@ -4,41 +4,28 @@
 #include <limits>
 #include <lipsyncd/dsp.hpp>
 
+#include "TemplateMatrix.hpp"
+
 namespace lipsyncd::dsp {
 
-namespace {
-// The distance the classifier uses between a frame and a template: Σ w·(x − t)² under the
-// per-feature weights, or ‖W(x − t)‖² under the set's whitening (lower triangular).
-double distance(const TemplateSet& set, std::span<const float> x, std::span<const float> t) {
-    const std::size_t n = std::min(x.size(), t.size());
-    double sum = 0;
-    if (set.whitening.empty()) {
-        for (std::size_t i = 0; i < n; ++i) {
-            const double d = static_cast<double>(x[i]) - t[i];
-            sum += set.binWeights[i] * d * d;
+SpeakerAdaptation::SpeakerAdaptation(TemplateSet base)
+    : base_(std::move(base)), weighting_(std::make_shared<const FeatureWeighting>(base_)) {
+    const std::size_t features = weighting_->features();
+    for (const auto& cls : base_.classes) {
+        classStart_.push_back(counts_.size());
+        for (const auto& spectrum : cls.spectra) {
+            weighted_.resize(weighted_.size() + features);
+            weighting_->transform(spectrum, std::span(weighted_).last(features));
+            counts_.push_back(0.0);
         }
-        return sum;
     }
-    for (std::size_t r = 0; r < n; ++r) {
-        double row = 0;
-        for (std::size_t c = 0; c <= r; ++c)
-            row += set.whitening[r][c] * (static_cast<double>(x[c]) - t[c]);
-        sum += row * row;
-    }
-    return sum;
-}
-}  // namespace
-
-SpeakerAdaptation::SpeakerAdaptation(TemplateSet base) : base_(std::move(base)) {
-    for (std::size_t c = 0; c < base_.classes.size(); ++c)
-        classOf_.insert(classOf_.end(), base_.classes[c].spectra.size(), c);
-    sums_.assign(classOf_.size() * base_.analysis.featureCount(), 0.0);
-    counts_.assign(classOf_.size(), 0.0);
+    sums_.assign(counts_.size() * features, 0.0);
 }
 
 void SpeakerAdaptation::add(std::span<const FrameFeatures> frames, const PhonemeSchedule& segments,
                             std::span<const std::uint8_t> silent) {
-    const std::size_t features = base_.analysis.featureCount();
+    const std::size_t features = weighting_->features();
+    std::vector<float> x(features);
     std::size_t f = 0;
     for (const auto& seg : segments) {
         const auto cls = std::find_if(base_.classes.begin(), base_.classes.end(),
@@ -47,24 +34,28 @@ void SpeakerAdaptation::add(std::span<const FrameFeatures> frames, const Phoneme
         std::size_t end = f;
         while (end < frames.size() && frames[end].time < seg.end) ++end;
         if (seg.phoneme == "sil" || cls == base_.classes.end() || end < f + 3) continue;
-        // The first template of the class in the flat arrays.
-        const auto classIndex = static_cast<std::size_t>(cls - base_.classes.begin());
-        const auto first = static_cast<std::size_t>(
-            std::find(classOf_.begin(), classOf_.end(), classIndex) - classOf_.begin());
-        for (std::size_t i = f + 1; i + 1 < end;
-             ++i) {  // the edge frames straddle two sounds  // the edge frames straddle two sounds
+        const std::size_t first =
+            classStart_[static_cast<std::size_t>(cls - base_.classes.begin())];
+        // The edge frames straddle two sounds.
+        for (std::size_t i = f + 1; i + 1 < end; ++i) {
             const auto& frame = frames[i];
             if (!frame.valid || frame.spectrum.size() != features) continue;
             if (i < silent.size() && silent[i]) continue;
-            std::size_t best = 0;
+            weighting_->transform(frame.spectrum, x);
+            std::size_t best = first;
             double bestDistance = std::numeric_limits<double>::infinity();
-            for (std::size_t t = 0; t < cls->spectra.size(); ++t) {
-                const double d = distance(base_, frame.spectrum, cls->spectra[t]);
+            for (std::size_t t = first; t < first + cls->spectra.size(); ++t) {
+                const float* w = &weighted_[t * features];
+                double d = 0;
+                for (std::size_t k = 0; k < features; ++k) {
+                    const double e = static_cast<double>(x[k]) - w[k];
+                    d += e * e;
+                }
                 if (d < bestDistance) bestDistance = d, best = t;
             }
-            double* sum = &sums_[(first + best) * features];
+            double* sum = &sums_[best * features];
             for (std::size_t k = 0; k < features; ++k) sum[k] += frame.spectrum[k];
-            counts_[first + best] += 1;
+            counts_[best] += 1;
             ++frames_;
         }
     }
@@ -79,7 +70,7 @@ void SpeakerAdaptation::add(const SpeakerAdaptation& other) {
 
 TemplateSet SpeakerAdaptation::adapted(float priorFrames) const {
     TemplateSet out = base_;
-    const std::size_t features = base_.analysis.featureCount();
+    const std::size_t features = weighting_->features();
     const double tau = std::max(0.0f, priorFrames);
     std::size_t t = 0;
     for (auto& cls : out.classes)

@@ -9,23 +9,41 @@
 
 namespace lipsyncd::dsp {
 
-TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& set)
+FeatureWeighting::FeatureWeighting(const TemplateSet& templates)
     : features_(templates.binWeights.size()) {
     scale_.resize(features_);
     for (std::size_t b = 0; b < features_; ++b) scale_[b] = std::sqrt(templates.binWeights[b]);
     for (const auto& row : templates.whitening)
         whitening_.insert(whitening_.end(), row.begin(), row.end());
-    std::vector<float> stored(features_);
+}
+
+void FeatureWeighting::transform(std::span<const float> frame, std::span<float> out) const {
+    if (whitening_.empty()) {
+        for (std::size_t b = 0; b < features_; ++b) out[b] = frame[b] * scale_[b];
+        return;
+    }
+    for (std::size_t r = 0; r < features_; ++r) {  // lower triangular: columns 0..r
+        const float* row = whitening_.data() + r * features_;
+        float sum = 0;
+        for (std::size_t c = 0; c <= r; ++c) sum += row[c] * frame[c];
+        out[r] = sum;
+    }
+}
+
+TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& set)
+    : weighting_(templates) {
+    const std::size_t features = weighting_.features();
+    std::vector<float> stored(features);
     for (const auto& c : templates.classes) {
         const auto idx = set.find(c.phoneme);
         if (!idx)
             throw InputError("templates: class '" + c.phoneme + "' is not in the phoneme set");
         for (std::size_t first = 0; first < c.spectra.size(); first += kLanes) {
             const std::size_t at = blocks_.size();
-            blocks_.resize(at + features_ * kLanes);
+            blocks_.resize(at + features * kLanes);
             for (std::size_t lane = 0; lane < kLanes; ++lane) {
                 transform(c.spectra[std::min(first + lane, c.spectra.size() - 1)], stored);
-                for (std::size_t b = 0; b < features_; ++b)
+                for (std::size_t b = 0; b < features; ++b)
                     blocks_[at + b * kLanes + lane] = stored[b];
             }
             blockClass_.push_back(static_cast<int>(*idx));
@@ -82,22 +100,9 @@ LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features
 }
 }  // namespace
 
-void TemplateMatrix::transform(std::span<const float> frame, std::span<float> out) const {
-    if (whitening_.empty()) {
-        for (std::size_t b = 0; b < features_; ++b) out[b] = frame[b] * scale_[b];
-        return;
-    }
-    for (std::size_t r = 0; r < features_; ++r) {  // lower triangular: columns 0..r
-        const float* row = whitening_.data() + r * features_;
-        float sum = 0;
-        for (std::size_t c = 0; c <= r; ++c) sum += row[c] * frame[c];
-        out[r] = sum;
-    }
-}
-
 void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out) const {
     std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
-    nearestPerClass(scaledFrame.data(), features_, blocks_.data(), blockClass_.data(),
+    nearestPerClass(scaledFrame.data(), features(), blocks_.data(), blockClass_.data(),
                     blockClass_.size(), out.data());
 }
 

@@ -17,6 +17,23 @@
 
 namespace lipsyncd::dsp {
 
+// A set's distance as a plain Euclidean one: features scaled by √w (the per-feature weights), or
+// multiplied by the set's whitening W (lower triangular), so that ‖T(x) − T(t)‖² is the set's
+// distance between a frame x and a template t.
+class FeatureWeighting {
+  public:
+    FeatureWeighting() = default;
+    explicit FeatureWeighting(const TemplateSet& templates);
+    std::size_t features() const { return features_; }
+    // `out` has features() values.
+    void transform(std::span<const float> frame, std::span<float> out) const;
+
+  private:
+    std::size_t features_ = 0;
+    std::vector<float> scale_;
+    std::vector<float> whitening_;  // [row][column], row-major; empty: diagonal scale_ only
+};
+
 class TemplateMatrix {
   public:
     static constexpr std::size_t kLanes = 8;
@@ -24,20 +41,19 @@ class TemplateMatrix {
     TemplateMatrix() = default;
     // Throws InputError for a class the phoneme set does not have.
     TemplateMatrix(const TemplateSet& templates, const PhonemeSet& set);
-    std::size_t features() const { return features_; }
-    // The frame as nearest() takes it: scaled by the weights, or multiplied by the set's
-    // whitening (TemplateSet::whitening, lower triangular). `out` has features() values.
-    void transform(std::span<const float> frame, std::span<float> out) const;
+    std::size_t features() const { return weighting_.features(); }
+    // The frame as nearest() takes it (FeatureWeighting). `out` has features() values.
+    void transform(std::span<const float> frame, std::span<float> out) const {
+        weighting_.transform(frame, out);
+    }
     // Squared weighted distance from a scaled frame to the nearest template of each class,
     // indexed by phoneme set index; +inf for classes without templates.
     void nearest(std::span<const float> scaledFrame, std::span<float> out) const;
 
   private:
-    std::size_t features_ = 0;
-    std::vector<float> scale_;
-    std::vector<float> whitening_;  // [row][column], row-major; empty: diagonal scale_ only
-    std::vector<float> blocks_;     // [block][feature][lane]
-    std::vector<int> blockClass_;   // phoneme set index of each block (blocks of a class adjacent)
+    FeatureWeighting weighting_;
+    std::vector<float> blocks_;    // [block][feature][lane]
+    std::vector<int> blockClass_;  // phoneme set index of each block (blocks of a class adjacent)
 };
 
 }  // namespace lipsyncd::dsp

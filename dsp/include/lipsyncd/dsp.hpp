@@ -180,6 +180,7 @@ struct FrameFeatures {
 class DirectLpcSpectrum;
 class FftLpcSpectrum;
 class TemplateMatrix;
+class FeatureWeighting;
 
 // The running spectral mean of AnalysisConfig::spectrumMean, over speech frames (valid and
 // within `kSpeechBelowPeakDb` of the recent peak), subtracted from each frame's spectrum.
@@ -866,9 +867,11 @@ class SpeakerAdaptation {
 
   private:
     TemplateSet base_;
-    std::vector<std::size_t> classOf_;  // per template: its class's index in base_.classes
-    std::vector<double> sums_;          // [template][feature]
-    std::vector<double> counts_;        // [template]
+    std::shared_ptr<const FeatureWeighting> weighting_;  // the classifier's distance
+    std::vector<float> weighted_;                        // [template][feature]: the base, weighted
+    std::vector<std::size_t> classStart_;  // per class of base_: its first template's index
+    std::vector<double> sums_;             // [template][feature]
+    std::vector<double> counts_;           // [template]
     std::size_t frames_ = 0;
 };
 
