@@ -67,13 +67,13 @@ struct Evaluator {
     dsp::TemplateSet templates = o.frontEnd.loadTemplates();
     lipsync::Runtime runtime = o.runtime.load();
     std::optional<PuppetJaw> puppet;
-    std::unique_ptr<EspeakSynthesizer> synth;  // --align: reads the words
+    std::unique_ptr<EspeakSynthesizer> synth;  // --align, --adapt-speaker: reads the words
     // --adapt-speaker: each speaker's voice so far, carried from file to file.
     mutable std::map<std::string, dsp::SpeakerAdaptation> speakers;
 
     explicit Evaluator(const EvalOptions& options) : o(options) {
         if (o.jaw) puppet.emplace(output::Puppet::named(o.puppet), o.jawActuator);
-        if (o.align) synth = std::make_unique<EspeakSynthesizer>();
+        if (o.align || o.adaptSpeaker) synth = std::make_unique<EspeakSynthesizer>();
     }
 
     // The pose track an envelope follower makes: its value on the jaw pose, nothing else.
@@ -128,19 +128,35 @@ struct Evaluator {
     // The schedule under test and the levels the runtime opens the jaw by: aligned on the
     // words beside the file (--align), else analysed from the audio alone.
     std::pair<PhonemeSchedule, LevelTrack> schedule(const CorpusItem& item) const {
-        if (!o.align) {
-            auto a = dsp::analyzeFile(item.audio, templates, set, o.frontEnd.config(),
-                                      o.frontEnd.decode(), std::nullopt);
-            return {std::move(a.schedule), std::move(a.levels)};
-        }
         dsp::SpeakerAdaptation* speaker = nullptr;
         if (o.adaptSpeaker) speaker = &speakers.try_emplace(item.speaker, templates).first->second;
+        if (!o.align) return analyse(item, speaker);
+        auto r = align(item, speaker);
+        return {std::move(r.schedule), std::move(r.levels)};
+    }
+
+    dsp::AlignFileResult align(const CorpusItem& item, dsp::SpeakerAdaptation* speaker) const {
         auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
                            voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner,
                            o.frontEnd.decode(), std::nullopt, o.reductions, speaker);
         for (const auto& w : r.warnings)
             std::cerr << "lipsync eval: " << item.speaker << '/' << item.name << ": " << w << '\n';
-        return {std::move(r.schedule), std::move(r.levels)};
+        return r;
+    }
+
+    // From the audio alone; with a speaker (the service's adapt_speaker), on the voice its
+    // earlier files taught, and then the file's words teach it in turn, as a line played with
+    // its words does: what the service makes of a file without words at that point of a show.
+    std::pair<PhonemeSchedule, LevelTrack> analyse(const CorpusItem& item,
+                                                   dsp::SpeakerAdaptation* speaker) const {
+        const auto own =
+            speaker && speaker->frames() > 0
+                ? std::optional(speaker->adapted(o.aligner.speakerAdaptationPriorFrames))
+                : std::nullopt;
+        auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
+                                  o.frontEnd.decode(), std::nullopt);
+        if (speaker && wordsBeside(item.audio)) align(item, speaker);
+        return {std::move(a.schedule), std::move(a.levels)};
     }
 
     Score scoreFile(const CorpusItem& item) const {
@@ -433,9 +449,11 @@ void addEvalCommand(CLI::App& app) {
         ->check(CLI::Range(0.0, 1000.0))
         ->capture_default_str();
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
-                  "With --align: carry each speaker's voice from file to file, in name order, as "
-                  "over a show's lines: each file starts from templates moved toward the frames "
-                  "placed in that speaker's earlier files");
+                  "Carry each speaker's voice from file to file, in name order, as over a show's "
+                  "lines: each file starts from templates moved toward the frames placed in that "
+                  "speaker's earlier files (aligned on their words, NAME.txt). Without --align "
+                  "each file is analysed from the audio on that voice, then its words teach it: "
+                  "the service's adapt_speaker for files played without words");
     cmd->add_flag("!--no-reductions", o->reductions,
                   "With --align: follow espeak-ng's reading only, without the common reductions "
                   "(config/reductions/LANG.toml)");

@@ -10,6 +10,8 @@
 #include <lipsyncd/tts.hpp>
 #include <optional>
 
+#include "ShowSpeaker.hpp"
+
 namespace lipsyncd::daemon {
 
 namespace {
@@ -21,6 +23,7 @@ struct ClipMaker::Impl {
     lipsync::Runtime runtime;  // built as `lipsync animate` builds it
     dsp::TemplateSet templates;
     std::vector<std::string> poseNames;
+    std::shared_ptr<ShowSpeaker> speaker;  // null: adapt_speaker = false
 
     explicit Impl(const DaemonConfig& c)
         : config(c),
@@ -29,14 +32,25 @@ struct ClipMaker::Impl {
           poseNames(runtime.poses().names()) {}
 };
 
-ClipMaker::ClipMaker(const DaemonConfig& config) {
+ClipMaker::ClipMaker(const DaemonConfig& config, const ClipMaker* previous) {
     try {
         impl_ = std::make_unique<Impl>(config);
     } catch (const InputError& e) {  // which key of the config named what failed to load
         throw InputError(config.source.string() + ": [mouth] " + e.what());
     }
+    if (!config.adaptSpeaker) return;
+    // A reload goes on with the voice learnt so far, unless the templates it adapts changed.
+    if (previous && previous->impl_->speaker &&
+        previous->impl_->config.templates == config.templates)
+        impl_->speaker = previous->impl_->speaker;
+    else
+        impl_->speaker = std::make_shared<ShowSpeaker>(impl_->templates);
 }
 ClipMaker::~ClipMaker() = default;
+
+ShowSpeaker* ClipMaker::speaker() const {
+    return impl_->speaker.get();
+}
 
 const std::vector<std::string>& ClipMaker::poseNames() const {
     return impl_->poseNames;
@@ -81,10 +95,13 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
     // Analysed on `channel` (the voice), played on the others (what the audience hears); the
     // analysis first, so its buffers are gone before the sound's is made. The mouth opens as
     // wide as the voice is loud: the analysis's own levels (as `lipsync analyze --weights`).
+    // The show's voice (adapt_speaker) is learnt on a copy and kept once the schedule is made.
     LevelTrack levels;
+    auto lesson = impl_->speaker ? std::optional(impl_->speaker->startLesson()) : std::nullopt;
     const auto schedule = scheduleForClip(
         synth, file, knownText, impl_->config.voice, impl_->templates, decode,
-        log ? log : [](const auto&) {}, &levels);
+        log ? log : [](const auto&) {}, &levels, lesson ? &lesson->voice : nullptr);
+    if (lesson) impl_->speaker->finish(std::move(*lesson));
     clip.weights = impl_->runtime.animate(schedule, &levels);
     dsp::DecodeOptions play;
     play.skipChannel = channel;
@@ -189,6 +206,9 @@ class StreamingLive : public ClipMaker::Live {
 }  // namespace
 
 std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
+    // Live input follows the show's voice as the lines with words before it taught it.
+    if (impl_->speaker)
+        return std::make_unique<StreamingLive>(impl_->speaker->templates(), impl_->runtime, rate);
     return std::make_unique<StreamingLive>(impl_->templates, impl_->runtime, rate);
 }
 

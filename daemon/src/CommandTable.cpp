@@ -31,6 +31,9 @@ constexpr ControlArg kPoseArgs[] = {
     {"weights", Type::Weights, true, kMaxPoses, 0, 1,
      "pose weights, NAME=VALUE each within 0..1 (poses not named: 0)"},
 };
+constexpr ControlArg kSpeakerArgs[] = {
+    {"action", Type::String, false, 16, 0, 0, "show (default) or reset (forget the voice)"},
+};
 constexpr ControlArg kOnArg[] = {
     {"on", Type::Boolean, false, 0, 0, 0, "on or off (default on)"},
 };
@@ -43,6 +46,8 @@ constexpr ControlCommand kCommands[] = {
     {"queue", "queue: what plays and what waits (as status)", "", {}},
     {"reload", "reload: read the configuration again (as SIGHUP)", "", {}},
     {"say", "say TEXT: queue speech", "text", kSayArgs},
+    {"speaker", "speaker [reset]: the show's voice learnt from lines with words, or forget it",
+     "action", kSpeakerArgs},
     {"status", "status: what plays, the queue, latency, the mouth", "", {}},
     {"stop", "stop: drop what plays and what waits", "", {}},
     {"subscribe", "subscribe: a frame event per 40 ms on this connection", "on", kOnArg},

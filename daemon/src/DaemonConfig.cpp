@@ -68,6 +68,7 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         r.loudness = mouth->optBool("loudness").value_or(r.loudness);
         c.templates = dataName(*mouth, "templates", "", "templates", ".json");
         c.voice = mouth->optString("voice").value_or(c.voice);
+        c.adaptSpeaker = mouth->optBool("adapt_speaker").value_or(c.adaptSpeaker);
         if (mouth->optNumber("lead"))
             mouth->fail("lead", "belongs to the puppet file now (lead = SECONDS: its servo lag)");
         c.syncOffsetSeconds = seconds(*mouth, "sync_offset", 0, -2, 2);

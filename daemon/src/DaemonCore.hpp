@@ -55,6 +55,8 @@ struct Daemon::Impl {
     std::string_view frameEvent(double t);  // this tick's frame event line (no allocation)
     void setupChanged();                    // a new setup: its pose and actuator names
     nlohmann::json statusReply() const;
+    nlohmann::json speakerReply() const;  // what the show's voice has learnt (status, speaker)
+    nlohmann::json speaker(const std::string& action);
 };
 
 }  // namespace lipsyncd::daemon

@@ -46,6 +46,7 @@ json Daemon::Impl::statusReply() const {
             {"live", live.has_value()},
             {"live_started", live ? live->started() : -1.0},
             {"latency", latency},
+            {"speaker", speakerReply()},
             // What clips hold: the one playing, and the queue (one made ready ahead at most).
             {"memory",
              {{"playing_bytes", clip ? bytesOf(*clip) : 0}, {"queue_bytes", queue.bytesHeld()}}}};

@@ -3,6 +3,7 @@
 #include <lipsyncd/tts.hpp>
 
 #include "DaemonCore.hpp"
+#include "ShowSpeaker.hpp"
 
 namespace lipsyncd::daemon {
 
@@ -22,6 +23,7 @@ json Daemon::Impl::handle(const json& r) {
         }
         if (cmd == "live") return setLive(r.value("on", true));
         if (cmd == "pose") return holdPose(r);
+        if (cmd == "speaker") return speaker(r.value("action", std::string("show")));
         return {{"ok", false}, {"error", cmd + ": only on a connection (subscribe)"}};
     } catch (const std::exception& e) {
         return {{"ok", false}, {"error", e.what()}};
@@ -86,6 +88,28 @@ json Daemon::Impl::setLive(bool on) {
             {"live", true},
             {"started", live->started()},
             {"front_end_latency", live->frontEndLatency()}};
+}
+
+json Daemon::Impl::speakerReply() const {
+    const auto* voice = setup->clips->speaker();
+    if (!voice) return {{"adapting", false}};
+    const auto heard = voice->heard();
+    return {{"adapting", true}, {"lines", heard.lines}, {"frames", heard.frames}};
+}
+
+json Daemon::Impl::speaker(const std::string& action) {
+    if (action != "show" && action != "reset")
+        return {{"ok", false},
+                {"error", "speaker: \"action\" must be show or reset, not '" + action + "'"}};
+    auto* voice = setup->clips->speaker();
+    if (!voice) return {{"ok", false}, {"error", "speaker: adapt_speaker is off in the config"}};
+    if (action == "reset") {
+        voice->reset();
+        status("the show's voice forgotten");
+    }
+    json reply = {{"ok", true}};
+    reply["speaker"] = speakerReply();
+    return reply;
 }
 
 }  // namespace lipsyncd::daemon

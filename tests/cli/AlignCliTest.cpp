@@ -90,5 +90,32 @@ TEST(AlignCli, TheLabellingScriptKeepsOnlyConfidentLabels) {
     EXPECT_EQ(usage.exitCode, 2);
 }
 
+// `eval --adapt-speaker` without --align: the service's adapt_speaker for files played without
+// words. The first file is analysed on the shipped templates (nothing learnt yet), the later
+// ones on the voice the earlier files' words taught.
+TEST(AlignCli, EvalAdaptSpeakerAnalysesEachFileOnTheVoiceTheEarlierOnesTaught) {
+    const auto dir = scratchDir("cli_eval_adapt");
+    const std::vector<std::string> lines = {"The old lighthouse keeper waved at every ship.",
+                                            "Nobody knew why the clock stopped at midnight.",
+                                            "Bring me the red umbrella before the storm."};
+    for (std::size_t i = 0; i < lines.size(); ++i)
+        speak(dir / "anna", "line" + std::to_string(i), lines[i], "en-us+klatt3", lines[i]);
+    auto files = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = {"eval", "--corpus", dir.string(), "--json", "-"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const auto r = runLipsync(args);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return nlohmann::json::parse(r.out.substr(r.out.find("\n{") + 1))["files"];
+    };
+    const auto plain = files({});
+    const auto adapted = files({"--adapt-speaker"});
+    ASSERT_EQ(plain.size(), 3u);
+    ASSERT_EQ(adapted.size(), 3u);
+    EXPECT_EQ(adapted[0]["accuracy"], plain[0]["accuracy"]);
+    EXPECT_TRUE(adapted[1]["accuracy"] != plain[1]["accuracy"] ||
+                adapted[2]["accuracy"] != plain[2]["accuracy"])
+        << "the later files were analysed on the shipped templates";
+}
+
 }  // namespace
 }  // namespace lipsyncd::test

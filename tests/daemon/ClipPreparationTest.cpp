@@ -161,3 +161,67 @@ TEST(ClipPreparation, KnownWordsBesideAPlayedFileAreAligned) {
 
 }  // namespace
 }  // namespace lipsyncd::test
+
+namespace lipsyncd::test {
+namespace {
+
+json speakerOf(Client& c) {
+    return c.request({{"cmd", "status"}})["speaker"];
+}
+
+// Plays a request until it has been prepared (it plays), then stops it: what a clip teaches is
+// learnt when it is made, before it is heard.
+void prepare(Client& c, const json& request) {
+    ASSERT_TRUE(c.request(request)["ok"]);
+    for (int i = 0; i < 400 && c.request({{"cmd", "status"}})["playing"].is_null(); ++i)
+        std::this_thread::sleep_for(50ms);
+    ASSERT_TRUE(c.request({{"cmd", "stop"}})["ok"]);
+}
+
+// The show's voice (adapt_speaker, on by default): a played file with its words teaches it, a
+// file without words does not; a reload with the same templates goes on with it, `speaker
+// reset` forgets it.
+TEST(ClipPreparation, LinesPlayedWithTheirWordsTeachTheShowsVoice) {
+    DaemonProcess d;
+    NotifySocket notify(d.dir / "notify");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    EXPECT_EQ(speakerOf(c), (json{{"adapting", true}, {"lines", 0}, {"frames", 0}}));
+    const auto wav = d.dir / "line.wav";
+    std::filesystem::copy_file(findDataFile("examples/hello.wav"), wav);
+    prepare(c, {{"cmd", "play"}, {"file", wav.string()}});  // no words
+    EXPECT_EQ(speakerOf(c)["lines"], 0);
+    const std::string words =
+        "Hello there! I am a puppet. Watch my mouth move when I talk, and wave back at me.";
+    prepare(c, {{"cmd", "play"}, {"file", wav.string()}, {"text", words}});
+    const auto taught = speakerOf(c);
+    EXPECT_EQ(taught["lines"], 1) << taught;
+    EXPECT_GT(taught["frames"].get<int>(), 100) << taught;
+    ::kill(d.pid, SIGHUP);
+    ASSERT_TRUE(notify.waitFor("RELOADING=1"));
+    std::this_thread::sleep_for(300ms);
+    EXPECT_EQ(speakerOf(c), taught) << "a reload forgot the voice";
+    const auto reset = c.request({{"cmd", "speaker"}, {"action", "reset"}});
+    ASSERT_TRUE(reset["ok"]) << reset;
+    EXPECT_EQ(reset["speaker"]["frames"], 0) << reset;
+    const auto bad = c.request({{"cmd", "speaker"}, {"action", "forget"}});
+    EXPECT_EQ(bad["ok"], false);
+    EXPECT_NE(errorOf(bad).find("show or reset"), std::string::npos) << bad;
+    EXPECT_EQ(d.stop(), 0);
+}
+
+TEST(ClipPreparation, WithAdaptSpeakerOffNothingIsLearnt) {
+    DaemonProcess d("adapt_speaker = false\n");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    EXPECT_EQ(speakerOf(c), (json{{"adapting", false}}));
+    const auto reply = c.request({{"cmd", "speaker"}});
+    EXPECT_EQ(reply["ok"], false);
+    EXPECT_NE(errorOf(reply).find("adapt_speaker"), std::string::npos) << reply;
+    EXPECT_EQ(d.stop(), 0);
+}
+
+}  // namespace
+}  // namespace lipsyncd::test

@@ -316,5 +316,37 @@ TEST(AlignText, WordsBesideAPlayedFileAreUsedAndLogged) {
     std::filesystem::remove(words);
 }
 
+// The service's show voice (lipsyncd's adapt_speaker): lines played with their words teach the
+// speaker, and a later file played without words is recognised on what they taught.
+TEST(AlignText, AFileWithoutWordsIsRecognisedOnTheVoiceTheLinesBeforeTaught) {
+    const std::string voice = "en-us+klatt3";
+    const auto templates = dsp::TemplateSet::loadDefault();
+    dsp::SpeakerAdaptation speaker(templates);
+    const auto quiet = [](const std::string&) {};
+    for (const std::string text : {"The old lighthouse keeper waved at every passing ship.",
+                                   "Nobody knew why the clock stopped at midnight.",
+                                   "Bring me the red umbrella before the storm arrives."}) {
+        const auto s = dull(speak(text, voice, 170));
+        scheduleForClip(synth(), wav("show_line.wav", s.samples, s.rate), text, "en-us", templates,
+                        {}, quiet, nullptr, &speaker);
+    }
+    ASSERT_GT(speaker.frames(), 150u);
+    const auto s = dull(speak(kLine, voice, 170));
+    const auto file = wav("show_unscripted.wav", s.samples, s.rate);
+    std::filesystem::remove(std::filesystem::path(file).replace_extension(".txt"));
+    auto groups = [&](dsp::SpeakerAdaptation* carried) {
+        const auto schedule = scheduleForClip(synth(), file, std::nullopt, "en-us", templates, {},
+                                              quiet, nullptr, carried);
+        return dsp::scoreSchedule(schedule, s.labels, PhonemeSet::common()).groupAccuracy();
+    };
+    const auto learnt = speaker.frames();
+    const double cold = groups(nullptr);
+    const double warm = groups(&speaker);
+    // Measured 60.9 → 65.7 %.
+    EXPECT_GT(warm, cold) << "visual groups " << cold << " on the shipped templates, " << warm
+                          << " on the voice the lines taught";
+    EXPECT_EQ(speaker.frames(), learnt);  // without words nothing is learnt
+}
+
 }  // namespace
 }  // namespace lipsyncd

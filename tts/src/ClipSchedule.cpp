@@ -32,7 +32,7 @@ PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem:
                                 const std::optional<std::string>& text, const std::string& voice,
                                 const dsp::TemplateSet& templates, const dsp::DecodeOptions& decode,
                                 const std::function<void(const std::string&)>& log,
-                                LevelTrack* levels) {
+                                LevelTrack* levels, dsp::SpeakerAdaptation* speaker) {
     std::optional<std::string> words = text;
     std::string source = "the request";
     if (!words)
@@ -42,7 +42,8 @@ PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem:
         }
     if (words) {
         try {
-            const auto r = alignText(synth, audio, *words, voice, templates, {}, {}, decode);
+            const auto r = alignText(synth, audio, *words, voice, templates, {}, {}, decode,
+                                     std::nullopt, true, speaker);
             log(audio.string() + ": words from " + source + " aligned" +
                 (r.fellBack ? " (fell back to audio-only analysis)" : ""));
             for (const auto& w : r.warnings) log(audio.string() + ": " + w);
@@ -53,7 +54,12 @@ PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem:
                 "; audio-only analysis");
         }
     }
-    auto r = dsp::analyzeFile(audio, templates, PhonemeSet::common(), {}, decode);
+    // Recognised on the speaker's voice as heard so far, when lines with words have taught it.
+    const auto own =
+        speaker && speaker->frames() > 0
+            ? std::optional(speaker->adapted(dsp::AlignerConfig{}.speakerAdaptationPriorFrames))
+            : std::nullopt;
+    auto r = dsp::analyzeFile(audio, own ? *own : templates, PhonemeSet::common(), {}, decode);
     if (levels) *levels = std::move(r.levels);
     return std::move(r.schedule);
 }

@@ -48,6 +48,8 @@ struct DaemonConfig {
     lipsync::RuntimeSpec runtime;
     std::string templates;  // empty: the shipped default (dsp::TemplateSet::named)
     std::string voice = "en-us";
+    // Learn the show's voice from the played files with words, for everything after (ShowSpeaker).
+    bool adaptSpeaker = true;
     // (The lead that makes up for servo lag belongs to the puppet file: Puppet::leadSeconds.)
     double syncOffsetSeconds = 0;  // the user's correction, + moves the mouth later
     bool hardware = true;          // open the puppet's GPIO/HID outputs
@@ -151,10 +153,14 @@ struct Clip {
     PoseTrack weights;
 };
 
+class ShowSpeaker;
+
 // The pieces a request needs to become a Clip, loaded from the config at start and on reload.
 class ClipMaker {
   public:
-    explicit ClipMaker(const DaemonConfig& config);
+    // `previous`: the maker a reload replaces; its show voice goes on if the templates are the
+    // same.
+    explicit ClipMaker(const DaemonConfig& config, const ClipMaker* previous = nullptr);
     ~ClipMaker();
     // A file's mouth: with its words (`knownText`, else a FILE.txt beside it) by forced
     // alignment (lipsync align), else by recognition; `log` says which was used.
@@ -167,6 +173,9 @@ class ClipMaker {
     Clip fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice,
                   double maxSeconds = 0) const;
     const std::vector<std::string>& poseNames() const;
+    // The voice learnt from the show's lines with words (null: adapt_speaker = false). Files
+    // without words and live input use it too.
+    ShowSpeaker* speaker() const;
     // The live path: front end and runtime in their streaming forms (causal: least delay).
     class Live;
     std::unique_ptr<Live> startLive(int rate) const;

@@ -120,12 +120,15 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
 // that cannot be aligned (empty, unreadable) falls back to the audio-only analysis. `log` gets
 // one line saying which was used, and the alignment's warnings. For the service's clip
 // preparation; `levels`, when given, gets the analysis's frame levels (the loudness shaping's
-// input, so the caller need not read the audio a second time).
+// input, so the caller need not read the audio a second time). `speaker`, when given, is the
+// voice of the lines before: an aligned file starts from it and adds to it (alignText), a file
+// without words is recognised on its templates once it has learnt any.
 PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                 const std::optional<std::string>& text, const std::string& voice,
                                 const dsp::TemplateSet& templates, const dsp::DecodeOptions& decode,
                                 const std::function<void(const std::string&)>& log,
-                                LevelTrack* levels = nullptr);
+                                LevelTrack* levels = nullptr,
+                                dsp::SpeakerAdaptation* speaker = nullptr);
 
 // The words file beside an audio file (FILE.wav → FILE.txt), if there is one.
 std::optional<std::filesystem::path> wordsBeside(const std::filesystem::path& audio);
