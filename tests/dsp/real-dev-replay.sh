@@ -9,7 +9,8 @@
 #
 # REPLAY_TEMPLATES=SET scores that template set (a name under config/templates/ or a file)
 # instead of the default one. REPLAY_ALIGN=1 scores `lipsync align` on each file's words
-# instead (eval --align), festvox-ru read by espeak-ng's ru voice.
+# instead (eval --align), festvox-ru read by espeak-ng's ru voice. REPLAY_ADAPT=1 carries each
+# speaker's voice from file to file (eval --adapt-speaker: what lipsyncd's adapt_speaker gives).
 #
 # Exits 77 (ctest: skipped) only when scripts/fetch-real-speech.sh cannot fetch the packages
 # or tools; any other failure fails the test.
@@ -26,11 +27,13 @@ fi
 [ "$rc" -eq 0 ] || exit "$rc"
 failed=0
 align=()
-[ -n "${REPLAY_ALIGN:-}" ] && align=(--align --voice festvox-ru-nsh=ru)
+[ -n "${REPLAY_ALIGN:-}" ] && align=(--align)
+[ -n "${REPLAY_ADAPT:-}" ] && align+=(--adapt-speaker)
+[ ${#align[@]} -gt 0 ] && align+=(--voice festvox-ru-nsh=ru)
 for pair in "$@"; do
   speaker="${pair%%=*}"
   IFS=: read -r group jaw closures falseClosures <<<"${pair#*=}"
-  echo "== $speaker, templates ${REPLAY_TEMPLATES:-default}${align:+, aligned on its words} (floors: visual groups $group, jaw r from audio $jaw," \
+  echo "== $speaker, templates ${REPLAY_TEMPLATES:-default}${REPLAY_ALIGN:+, aligned on its words}${REPLAY_ADAPT:+, the voice carried from file to file} (floors: visual groups $group, jaw r from audio $jaw," \
     "closures caught ${closures:-0}, false closures at most ${falseClosures:-1})"
   "$lipsync" eval --corpus "$out/dev/$speaker" --no-per-file --templates "${REPLAY_TEMPLATES:-default}" "${align[@]}" \
     --min-group-accuracy "$group" \
