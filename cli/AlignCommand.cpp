@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "AlignerOptions.hpp"
 #include "Commands.hpp"
 #include "Corpus.hpp"
 #include "FrontEndOptions.hpp"
@@ -25,12 +26,10 @@ struct AlignOptions {
     std::string schedule;
     std::string words;
     std::string format = "tsv";
-    float minWordConfidence = dsp::AlignerConfig{}.minWordConfidence;
-    float silenceInSpeechCost = dsp::AlignerConfig{}.silenceInSpeechCost;
-    float secondPassPrior = dsp::AlignerConfig{}.fileAdaptationPriorFrames;
+    AlignerOptions aligner;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
-    bool quiet = false, reductions = true;
+    bool quiet = false;
 };
 
 void writeWords(std::ostream& out, const std::vector<dsp::AlignedWord>& words) {
@@ -63,13 +62,10 @@ void writeJson(std::ostream& out, const dsp::AlignFileResult& r) {
 void runAlign(const AlignOptions& o) {
     const std::string text = o.textFile.empty() ? o.text : readTextFile(o.textFile);
     const auto templates = o.frontEnd.loadTemplates();
-    dsp::AlignerConfig aligner;
-    aligner.minWordConfidence = o.minWordConfidence;
-    aligner.silenceInSpeechCost = o.silenceInSpeechCost;
-    aligner.fileAdaptationPriorFrames = o.secondPassPrior;
     EspeakSynthesizer synth;
-    const auto r = alignText(synth, o.input, text, o.voice, templates, o.frontEnd.config(), aligner,
-                             o.frontEnd.decode(), o.frontEnd.raw(), o.reductions);
+    const auto r =
+        alignText(synth, o.input, text, o.voice, templates, o.frontEnd.config(), o.aligner.config,
+                  o.frontEnd.decode(), o.frontEnd.raw(), o.aligner.reductions);
     for (const auto& w : r.warnings) std::cerr << "lipsync align: warning: " << w << '\n';
     if (!o.quiet) {
         const auto placed = std::count_if(r.alignment.words.begin(), r.alignment.words.end(),
@@ -112,24 +108,7 @@ void addAlignCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voice,
                     "espeak-ng voice whose reading of the words to follow (its language)")
         ->capture_default_str();
-    cmd->add_option("--min-word-confidence", o->minWordConfidence,
-                    "Words placed with less confidence get audio-only analysis; in a line whose "
-                    "median word confidence reaches it, a word needs only 0.4 of that median, and "
-                    "the word of a one-word line 0.1 (never more than this)")
-        ->check(CLI::Range(0.0, 1.0))
-        ->capture_default_str();
-    cmd->add_option("--silence-in-speech-cost", o->silenceInSpeechCost,
-                    "Cost per frame of silence where the energy gate hears speech")
-        ->check(CLI::Range(0.0, 100.0))
-        ->capture_default_str();
-    cmd->add_option("--second-pass-prior", o->secondPassPrior,
-                    "Align a second time on templates moved toward the file's own voice (what the "
-                    "first pass placed); the templates weigh as this many frames (0: one pass)")
-        ->check(CLI::Range(0.0, 1000.0))
-        ->capture_default_str();
-    cmd->add_flag("!--no-reductions", o->reductions,
-                  "Follow espeak-ng's reading only, without the common reductions "
-                  "(config/reductions/LANG.toml: weak forms, t/d and schwa deletion)");
+    o->aligner.addTo(*cmd);
     cmd->add_flag("--quiet,-q", o->quiet, "No summary on stderr");
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, true);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "AlignerOptions.hpp"
 #include "Commands.hpp"
 #include "Corpus.hpp"
 #include "FrontEndOptions.hpp"
@@ -32,8 +33,8 @@ struct EvalOptions {
     // --align: each NAME.wav is aligned on the words of NAME.txt beside it (lipsync align)
     // instead of analysed from the audio alone; voices: "VOICE" for every speaker, or
     // "SPEAKER=VOICE" for one.
-    bool align = false, reductions = true, adaptSpeaker = false;
-    dsp::AlignerConfig aligner;
+    bool align = false, adaptSpeaker = false;
+    AlignerOptions aligner;
     std::vector<std::string> voices;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
@@ -137,8 +138,8 @@ struct Evaluator {
 
     dsp::AlignFileResult align(const CorpusItem& item, dsp::SpeakerAdaptation* speaker) const {
         auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
-                           voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner,
-                           o.frontEnd.decode(), std::nullopt, o.reductions, speaker);
+                           voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner.config,
+                           o.frontEnd.decode(), std::nullopt, o.aligner.reductions, speaker);
         for (const auto& w : r.warnings)
             std::cerr << "lipsync eval: " << item.speaker << '/' << item.name << ": " << w << '\n';
         return r;
@@ -151,7 +152,7 @@ struct Evaluator {
                                                    dsp::SpeakerAdaptation* speaker) const {
         const auto own =
             speaker && speaker->frames() > 0
-                ? std::optional(speaker->adapted(o.aligner.speakerAdaptationPriorFrames))
+                ? std::optional(speaker->adapted(o.aligner.config.speakerAdaptationPriorFrames))
                 : std::nullopt;
         auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
                                   o.frontEnd.decode(), std::nullopt);
@@ -428,35 +429,13 @@ void addEvalCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voices,
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");
-    cmd->add_option("--min-word-confidence", o->aligner.minWordConfidence,
-                    "With --align: words placed with less confidence get audio-only analysis; in a "
-                    "line whose "
-                    "median word confidence reaches it, a word needs only 0.4 of that median, and "
-                    "the word of a one-word line 0.1 (never more than this)")
-        ->check(CLI::Range(0.0, 1.0))
-        ->capture_default_str();
-    cmd->add_option("--reduction-cost", o->aligner.reductionCost,
-                    "With --align: cost of saying a word another way than espeak-ng reads it")
-        ->check(CLI::Range(0.0, 100.0))
-        ->capture_default_str();
-    cmd->add_option("--silence-in-speech-cost", o->aligner.silenceInSpeechCost,
-                    "With --align: cost per frame of silence where the energy gate hears speech")
-        ->check(CLI::Range(0.0, 100.0))
-        ->capture_default_str();
-    cmd->add_option("--second-pass-prior", o->aligner.fileAdaptationPriorFrames,
-                    "With --align: align a second time on templates moved toward the file's own "
-                    "voice; the templates weigh as this many frames (0: one pass)")
-        ->check(CLI::Range(0.0, 1000.0))
-        ->capture_default_str();
+    o->aligner.addTo(*cmd, "With --align");
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "
                   "lines: each file starts from templates moved toward the frames placed in that "
                   "speaker's earlier files (aligned on their words, NAME.txt). Without --align "
                   "each file is analysed from the audio on that voice, then its words teach it: "
                   "the service's adapt_speaker for files played without words");
-    cmd->add_flag("!--no-reductions", o->reductions,
-                  "With --align: follow espeak-ng's reading only, without the common reductions "
-                  "(config/reductions/LANG.toml)");
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, false);
     cmd->callback([o] { runEval(*o); });

@@ -1,0 +1,52 @@
+// Options every command that runs the known-script aligner shares (align, eval --align): its
+// floors and costs, the second pass, and the common reductions.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cctype>
+#include <lipsyncd/dsp.hpp>
+#include <string>
+
+namespace lipsyncd::cli {
+
+struct AlignerOptions {
+    dsp::AlignerConfig config;
+    bool reductions = true;
+
+    // `when`: what the options depend on, said before each help text ("With --align"), or empty.
+    void addTo(CLI::App& cmd, const std::string& when = "") {
+        const auto help = [&](std::string text) {
+            if (when.empty()) {
+                text[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
+                return text;
+            }
+            return when + ": " + text;
+        };
+        cmd.add_option("--min-word-confidence", config.minWordConfidence,
+                       help("words placed with less confidence get audio-only analysis; in a line "
+                            "whose median word confidence reaches it, a word needs only 0.4 of "
+                            "that median, and the word of a one-word line 0.1 (never more than "
+                            "this)"))
+            ->check(CLI::Range(0.0, 1.0))
+            ->capture_default_str();
+        cmd.add_option("--reduction-cost", config.reductionCost,
+                       help("cost of saying a word another way than espeak-ng reads it"))
+            ->check(CLI::Range(0.0, 100.0))
+            ->capture_default_str();
+        cmd.add_option("--silence-in-speech-cost", config.silenceInSpeechCost,
+                       help("cost per frame of silence where the energy gate hears speech"))
+            ->check(CLI::Range(0.0, 100.0))
+            ->capture_default_str();
+        cmd.add_option("--second-pass-prior", config.fileAdaptationPriorFrames,
+                       help("align a second time on templates moved toward the file's own voice "
+                            "(what the first pass placed); the templates weigh as this many "
+                            "frames (0: one pass)"))
+            ->check(CLI::Range(0.0, 1000.0))
+            ->capture_default_str();
+        cmd.add_flag("!--no-reductions", reductions,
+                     help("follow espeak-ng's reading only, without the common reductions "
+                          "(config/reductions/LANG.toml: weak forms, t/d and schwa deletion)"));
+    }
+};
+
+}  // namespace lipsyncd::cli
