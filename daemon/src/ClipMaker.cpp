@@ -97,11 +97,16 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
     // wide as the voice is loud: the analysis's own levels (as `lipsync analyze --weights`).
     // The show's voice (adapt_speaker) is learnt on a copy and kept once the schedule is made.
     LevelTrack levels;
+    const auto say = log ? log : [](const std::string&) {};
     auto lesson = impl_->speaker ? std::optional(impl_->speaker->startLesson()) : std::nullopt;
-    const auto schedule = scheduleForClip(
-        synth, file, knownText, impl_->config.voice, impl_->templates, decode,
-        log ? log : [](const auto&) {}, &levels, lesson ? &lesson->voice : nullptr);
-    if (lesson) impl_->speaker->finish(std::move(*lesson));
+    const auto schedule =
+        scheduleForClip(synth, file, knownText, impl_->config.voice, impl_->templates, decode, say,
+                        &levels, lesson ? &lesson->voice : nullptr);
+    if (lesson && impl_->speaker->finish(std::move(*lesson))) {
+        const auto heard = impl_->speaker->heard();
+        say(file.string() + ": the show's voice learnt from " + std::to_string(heard.lines) +
+            " line(s), " + std::to_string(heard.frames) + " frames");
+    }
     clip.weights = impl_->runtime.animate(schedule, &levels);
     dsp::DecodeOptions play;
     play.skipChannel = channel;

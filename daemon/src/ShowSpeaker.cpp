@@ -9,11 +9,12 @@ ShowSpeaker::Lesson ShowSpeaker::startLesson() const {
     return {voice_, generation_};
 }
 
-void ShowSpeaker::finish(Lesson lesson) {
+bool ShowSpeaker::finish(Lesson lesson) {
     const std::lock_guard lock(mutex_);
-    if (lesson.generation != generation_ || lesson.voice.frames() <= voice_.frames()) return;
+    if (lesson.generation != generation_ || lesson.voice.frames() <= voice_.frames()) return false;
     voice_ = std::move(lesson.voice);
     ++lines_;
+    return true;
 }
 
 dsp::TemplateSet ShowSpeaker::templates() const {

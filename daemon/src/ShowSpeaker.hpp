@@ -21,7 +21,8 @@ class ShowSpeaker {
         std::uint64_t generation = 0;
     };
     Lesson startLesson() const;
-    void finish(Lesson lesson);  // kept unless reset() came after startLesson()
+    // Kept unless reset() came after startLesson(); true when the line taught something.
+    bool finish(Lesson lesson);
 
     // The base templates moved toward the voice heard (the base itself before any line), under
     // the prior alignment gives a speaker carried from line to line.

@@ -198,6 +198,7 @@ TEST(ClipPreparation, LinesPlayedWithTheirWordsTeachTheShowsVoice) {
     const auto taught = speakerOf(c);
     EXPECT_EQ(taught["lines"], 1) << taught;
     EXPECT_GT(taught["frames"].get<int>(), 100) << taught;
+    EXPECT_NE(d.log().find("the show's voice learnt from 1 line(s)"), std::string::npos) << d.log();
     ::kill(d.pid, SIGHUP);
     ASSERT_TRUE(notify.waitFor("RELOADING=1"));
     std::this_thread::sleep_for(300ms);
