@@ -32,19 +32,22 @@ struct ClipMaker::Impl {
           poseNames(runtime.poses().names()) {}
 };
 
-ClipMaker::ClipMaker(const DaemonConfig& config, const ClipMaker* previous) {
+ClipMaker::ClipMaker(const DaemonConfig& config, const ClipMaker* previous,
+                     const std::function<void(const std::string&)>& log) {
     try {
         impl_ = std::make_unique<Impl>(config);
     } catch (const InputError& e) {  // which key of the config named what failed to load
         throw InputError(config.source.string() + ": [mouth] " + e.what());
     }
     if (!config.adaptSpeaker) return;
-    // A reload goes on with the voice learnt so far, unless the templates it adapts changed.
-    if (previous && previous->impl_->speaker &&
-        previous->impl_->config.templates == config.templates)
-        impl_->speaker = previous->impl_->speaker;
+    // A reload goes on with the voice learnt so far, unless what it adapts or keeps it changed.
+    const auto* before = previous ? previous->impl_.get() : nullptr;
+    if (before && before->speaker && before->config.templates == config.templates &&
+        before->config.speakerFile == config.speakerFile)
+        impl_->speaker = before->speaker;
     else
-        impl_->speaker = std::make_shared<ShowSpeaker>(impl_->templates);
+        impl_->speaker = std::make_shared<ShowSpeaker>(
+            impl_->templates, config.speakerFile, log ? log : [](const std::string&) {});
 }
 ClipMaker::~ClipMaker() = default;
 
@@ -85,6 +88,20 @@ std::vector<std::int16_t> decodeForPlayback(const std::filesystem::path& file,
 }
 }  // namespace
 
+namespace {
+// What a played line taught the show's voice, kept (and written to its file), and said.
+void learnFrom(ShowSpeaker& speaker, const std::filesystem::path& file, ShowSpeaker::Lesson lesson,
+               const std::function<void(const std::string&)>& log) {
+    const auto done = speaker.finish(std::move(lesson));
+    if (!done.saveProblem.empty())
+        log("the show's voice is not kept for a restart: " + done.saveProblem);
+    if (!done.learnt) return;
+    const auto heard = speaker.heard();
+    log(file.string() + ": the show's voice learnt from " + std::to_string(heard.lines) +
+        " line(s), " + std::to_string(heard.frames) + " frames");
+}
+}  // namespace
+
 Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakSynthesizer& synth,
                          const std::optional<std::string>& knownText,
                          const std::function<void(const std::string&)>& log) const {
@@ -102,11 +119,7 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
     const auto schedule =
         scheduleForClip(synth, file, knownText, impl_->config.voice, impl_->templates, decode, say,
                         &levels, lesson ? &lesson->voice : nullptr);
-    if (lesson && impl_->speaker->finish(std::move(*lesson))) {
-        const auto heard = impl_->speaker->heard();
-        say(file.string() + ": the show's voice learnt from " + std::to_string(heard.lines) +
-            " line(s), " + std::to_string(heard.frames) + " frames");
-    }
+    if (lesson) learnFrom(*impl_->speaker, file, std::move(*lesson), say);
     clip.weights = impl_->runtime.animate(schedule, &levels);
     dsp::DecodeOptions play;
     play.skipChannel = channel;

@@ -69,6 +69,7 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         c.templates = dataName(*mouth, "templates", "", "templates", ".json");
         c.voice = mouth->optString("voice").value_or(c.voice);
         c.adaptSpeaker = mouth->optBool("adapt_speaker").value_or(c.adaptSpeaker);
+        c.speakerFile = mouth->optString("speaker_file").value_or("");
         if (mouth->optNumber("lead"))
             mouth->fail("lead", "belongs to the puppet file now (lead = SECONDS: its servo lag)");
         c.syncOffsetSeconds = seconds(*mouth, "sync_offset", 0, -2, 2);

@@ -17,7 +17,8 @@ std::string puppetFileText(const std::string& nameOrPath) {
 
 Setup::Setup(DaemonConfig c, Setup* previous, const std::function<void(const std::string&)>& warn)
     : config(std::move(c)) {
-    clips = std::make_shared<const ClipMaker>(config, previous ? previous->clips.get() : nullptr);
+    clips =
+        std::make_shared<const ClipMaker>(config, previous ? previous->clips.get() : nullptr, warn);
     puppetText = puppetFileText(config.puppet);
     const bool keepDriver = previous && previous->keepsDriverFor(*this);
     const bool keepAudio = previous && previous->config.device == config.device;

@@ -178,6 +178,16 @@ void prepare(Client& c, const json& request) {
     ASSERT_TRUE(c.request({{"cmd", "stop"}})["ok"]);
 }
 
+// A line with its words, prepared (and so learnt) then stopped.
+void prepareLine(const DaemonProcess& d, Client& c) {
+    const auto wav = d.dir / "line.wav";
+    if (!std::filesystem::exists(wav))
+        std::filesystem::copy_file(findDataFile("examples/hello.wav"), wav);
+    prepare(c, {{"cmd", "play"},
+                {"file", wav.string()},
+                {"text", "Hello there! I am a puppet. Watch my mouth move when I talk."}});
+}
+
 // The show's voice (adapt_speaker, on by default): a played file with its words teaches it, a
 // file without words does not; a reload with the same templates goes on with it, `speaker
 // reset` forgets it.
@@ -192,9 +202,7 @@ TEST(ClipPreparation, LinesPlayedWithTheirWordsTeachTheShowsVoice) {
     std::filesystem::copy_file(findDataFile("examples/hello.wav"), wav);
     prepare(c, {{"cmd", "play"}, {"file", wav.string()}});  // no words
     EXPECT_EQ(speakerOf(c)["lines"], 0);
-    const std::string words =
-        "Hello there! I am a puppet. Watch my mouth move when I talk, and wave back at me.";
-    prepare(c, {{"cmd", "play"}, {"file", wav.string()}, {"text", words}});
+    prepareLine(d, c);
     const auto taught = speakerOf(c);
     EXPECT_EQ(taught["lines"], 1) << taught;
     EXPECT_GT(taught["frames"].get<int>(), 100) << taught;
@@ -209,6 +217,61 @@ TEST(ClipPreparation, LinesPlayedWithTheirWordsTeachTheShowsVoice) {
     const auto bad = c.request({{"cmd", "speaker"}, {"action", "forget"}});
     EXPECT_EQ(bad["ok"], false);
     EXPECT_NE(errorOf(bad).find("show or reset"), std::string::npos) << bad;
+    EXPECT_EQ(d.stop(), 0);
+}
+
+// speaker_file: the voice outlives a restart; a reset removes it; a broken file is said and the
+// service starts with an empty voice.
+TEST(ClipPreparation, TheShowsVoiceOutlivesARestartInItsFile) {
+    const auto voice = scratchDir("daemon_voice") / "voice.json";
+    std::filesystem::remove(voice);
+    const std::string key = "speaker_file = \"" + voice.string() + "\"\n";
+    json taught;
+    {
+        DaemonProcess d(key);
+        d.start();
+        Client c(d.socket());
+        ASSERT_TRUE(c.connected());
+        prepareLine(d, c);
+        taught = speakerOf(c);
+        ASSERT_GT(taught["frames"].get<int>(), 100) << taught;
+        EXPECT_TRUE(std::filesystem::exists(voice));
+        EXPECT_EQ(d.stop(), 0);
+    }
+    {
+        DaemonProcess d(key);
+        d.start();
+        Client c(d.socket());
+        ASSERT_TRUE(c.connected());
+        EXPECT_EQ(speakerOf(c)["frames"], taught["frames"]);
+        EXPECT_NE(d.log().find("the show's voice from " + voice.string()), std::string::npos)
+            << d.log();
+        ASSERT_TRUE(c.request({{"cmd", "speaker"}, {"action", "reset"}})["ok"]);
+        EXPECT_FALSE(std::filesystem::exists(voice));
+        EXPECT_EQ(d.stop(), 0);
+    }
+    std::ofstream(voice) << "{\"format\": \"lipsyncd-speaker\", \"version\": 1}\n";
+    DaemonProcess d(key);
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    EXPECT_EQ(speakerOf(c)["frames"], 0);
+    EXPECT_NE(d.log().find(voice.string()), std::string::npos) << d.log();
+    EXPECT_NE(d.log().find("starts again"), std::string::npos) << d.log();
+    EXPECT_EQ(d.stop(), 0);
+}
+
+// A speaker file that cannot be written is said; the voice is still learnt and used.
+TEST(ClipPreparation, AVoiceFileThatCannotBeWrittenIsSaidAndTheVoiceStillLearnt) {
+    DaemonProcess d("speaker_file = \"/nonexistent/lipsyncd/voice.json\"\n");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    prepareLine(d, c);
+    EXPECT_GT(speakerOf(c)["frames"].get<int>(), 100);
+    EXPECT_NE(d.log().find("not kept for a restart: /nonexistent/lipsyncd/voice.json"),
+              std::string::npos)
+        << d.log();
     EXPECT_EQ(d.stop(), 0);
 }
 

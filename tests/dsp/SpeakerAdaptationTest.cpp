@@ -2,6 +2,8 @@
 // frames of its class nearest to it, and what it must leave alone.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <lipsyncd/dsp.hpp>
 
 namespace lipsyncd::dsp {
@@ -77,6 +79,50 @@ TEST(SpeakerAdaptation, FramesAreAssignedAgainstTheBaseSoOrderDoesNotMatter) {
     first.add(second);
     EXPECT_EQ(first.frames(), one.frames());
     EXPECT_EQ(first.adapted(2).classes[0].spectra, one.adapted(2).classes[0].spectra);
+}
+
+// lipsyncd's speaker_file: what was learnt comes back after a restart, but only onto the base
+// set it was learnt on, and a broken file names its field and changes nothing.
+TEST(SpeakerAdaptation, WhatWasLearntIsKeptInAFileAcrossRuns) {
+    const auto file = std::filesystem::temp_directory_path() / "lipsyncd_speaker.json";
+    SpeakerAdaptation learnt(twoClasses());
+    learnt.add(frames(6, 12, 8), {{0.0, 0.06, "ah"}});
+    learnt.add(frames(6, -4, 6), {{0.0, 0.06, "d"}});
+    learnt.save(file);
+    EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(file) += ".tmp"));
+    SpeakerAdaptation restarted(twoClasses());
+    restarted.load(file);
+    EXPECT_EQ(restarted.frames(), learnt.frames());
+    EXPECT_EQ(restarted.adapted(3).classes[0].spectra, learnt.adapted(3).classes[0].spectra);
+    EXPECT_EQ(restarted.adapted(3).classes[1].spectra, learnt.adapted(3).classes[1].spectra);
+
+    auto other = twoClasses();
+    other.classes[1].spectra[0] = {-6, 5};
+    SpeakerAdaptation elsewhere(other);
+    try {
+        elsewhere.load(file);
+        ADD_FAILURE() << "loaded a voice learnt on other templates";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("'base'"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(elsewhere.frames(), 0u);
+
+    std::string text;
+    {
+        std::ifstream in(file);
+        std::getline(in, text);
+    }
+    text.replace(text.find("\"sum\":["), 7, "\"sum\":[1,");  // one number too many
+    std::ofstream(file) << text;
+    try {
+        restarted.load(file);
+        ADD_FAILURE() << "loaded a broken file";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("heard[0].sum"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(restarted.frames(), learnt.frames());  // what it had stays
+    std::filesystem::remove(file);
 }
 
 }  // namespace

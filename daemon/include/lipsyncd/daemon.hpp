@@ -50,6 +50,7 @@ struct DaemonConfig {
     std::string voice = "en-us";
     // Learn the show's voice from the played files with words, for everything after (ShowSpeaker).
     bool adaptSpeaker = true;
+    std::filesystem::path speakerFile;  // where the voice outlives a restart (empty: memory only)
     // (The lead that makes up for servo lag belongs to the puppet file: Puppet::leadSeconds.)
     double syncOffsetSeconds = 0;  // the user's correction, + moves the mouth later
     bool hardware = true;          // open the puppet's GPIO/HID outputs
@@ -158,9 +159,10 @@ class ShowSpeaker;
 // The pieces a request needs to become a Clip, loaded from the config at start and on reload.
 class ClipMaker {
   public:
-    // `previous`: the maker a reload replaces; its show voice goes on if the templates are the
-    // same.
-    explicit ClipMaker(const DaemonConfig& config, const ClipMaker* previous = nullptr);
+    // `previous`: the maker a reload replaces; its show voice goes on if the templates and the
+    // speaker file are the same. `log`: what became of the speaker file.
+    explicit ClipMaker(const DaemonConfig& config, const ClipMaker* previous = nullptr,
+                       const std::function<void(const std::string&)>& log = {});
     ~ClipMaker();
     // A file's mouth: with its words (`knownText`, else a FILE.txt beside it) by forced
     // alignment (lipsync align), else by recognition; `log` says which was used.

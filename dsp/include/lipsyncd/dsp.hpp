@@ -864,6 +864,13 @@ class SpeakerAdaptation {
     TemplateSet adapted(float priorFrames) const;
     std::size_t frames() const { return frames_; }  // frames learnt so far
     const TemplateSet& base() const { return base_; }
+    // What has been learnt, kept in a file across runs (lipsyncd's speaker_file): the templates
+    // heard, with a fingerprint of the base set. save() writes FILE.tmp and renames it over FILE,
+    // so a crash leaves the last good file. load() replaces what has been learnt; InputError
+    // naming the file and field when it is not such a file or was learnt on another base set
+    // (what had been learnt stays).
+    void save(const std::filesystem::path& file) const;
+    void load(const std::filesystem::path& file);
 
   private:
     TemplateSet base_;
