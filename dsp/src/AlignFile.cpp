@@ -7,10 +7,14 @@
 #include <lipsyncd/dsp.hpp>
 #include <sstream>
 
+#include "AdaptedDistances.hpp"
+
 namespace lipsyncd::dsp {
 
 namespace {
 constexpr std::size_t kReadBlock = 4096;
+// The level pass reads this many of its 10 ms blocks at once.
+constexpr std::size_t kLevelBlocksPerRead = 64;
 // Speech is what lies within this many dB of the loudest 10 ms block, and above the floor.
 constexpr double kSpeechBelowPeakDb = 35, kSpeechFloorDbfs = -55;
 // ... and clear of the room: the room's level is this quantile of the 10 ms blocks' levels
@@ -113,22 +117,27 @@ SpeechTiming measureSpeechTiming(std::span<const ScriptWord> script,
                                  const std::optional<RawFormat>& raw) {
     auto decoder = AudioDecoder::open(file, decode, raw);
     const auto blockSize = std::max<std::size_t>(1, decoder.sampleRate() / 100);
-    std::vector<float> block(blockSize);
+    // Read many 10 ms blocks at a time: a read is a system call for uncompressed files, and a
+    // call per 10 ms block cost more than the sums.
+    std::vector<float> buffer(blockSize * kLevelBlocksPerRead);
     std::vector<float> levels;  // dBFS per 10 ms: 400 bytes a second of audio
     std::int64_t samples = 0;
-    for (;;) {
+    for (bool end = false; !end;) {
         std::size_t got = 0;
-        while (got < blockSize) {
-            const auto n = decoder.read(std::span<float>(block).subspan(got));
+        while (got < buffer.size()) {
+            const auto n = decoder.read(std::span<float>(buffer).subspan(got));
             if (n == 0) break;
             got += n;
         }
-        if (got == 0) break;
-        samples += got;
-        double sum = 0;
-        for (std::size_t i = 0; i < got; ++i) sum += double(block[i]) * block[i];
-        levels.push_back(static_cast<float>(10 * std::log10(sum / got + 1e-20)));
-        if (got < blockSize) break;
+        end = got < buffer.size();
+        samples += static_cast<std::int64_t>(got);
+        for (std::size_t at = 0; at < got; at += blockSize) {
+            const auto block =
+                std::span<const float>(buffer).subspan(at, std::min(blockSize, got - at));
+            double sum = 0;
+            for (const float v : block) sum += double(v) * v;
+            levels.push_back(static_cast<float>(10 * std::log10(sum / block.size() + 1e-20)));
+        }
     }
     SpeechTiming timing;
     timing.durationSeconds = static_cast<double>(samples) / decoder.sampleRate();
@@ -168,48 +177,61 @@ PhonemeSchedule placedSegments(const Alignment& a) {
     return placed;
 }
 
-// The frames a second pass needs (FrameClassifier::classify's inputs), up to a bound (about
-// 440 bytes a frame: 13 MB for AlignerConfig::fileAdaptationMaxSeconds).
+// The frames a second pass needs, with the first pass's gate and its distances per block of
+// templates (FrameClassifier::blockDistances()), up to a bound (about 740 bytes a frame: 22 MB
+// for AlignerConfig::fileAdaptationMaxSeconds).
 class KeptFrames {
   public:
     explicit KeptFrames(std::size_t limit) : limit_(limit) {}
-    void add(const FrameFeatures& frame, bool silent) {
+    // Room for the frames expected, so that they are not copied as the arrays grow.
+    void reserve(std::size_t frames, std::size_t blocksPerFrame) {
+        frames = std::min(frames, limit_);
+        frames_.reserve(frames);
+        silent_.reserve(frames);
+        blocks_.reserve(frames * blocksPerFrame);
+    }
+    void add(const FrameFeatures& frame, bool silent, std::span<const float> blocks) {
         if (frames_.size() >= limit_) {
             overflow_ = true;
             return;
         }
+        if (frames_.empty()) blocksPerFrame_ = blocks.size();
         frames_.push_back(frame);
         silent_.push_back(silent);
+        blocks_.insert(blocks_.end(), blocks.begin(), blocks.end());
     }
     bool complete() const { return limit_ > 0 && !overflow_; }
     std::span<const FrameFeatures> frames() const { return frames_; }
     std::span<const std::uint8_t> silent() const { return silent_; }  // below the energy gate
+    std::span<const float> blocks(std::size_t frame) const {
+        return std::span(blocks_).subspan(frame * blocksPerFrame_, blocksPerFrame_);
+    }
 
   private:
     std::size_t limit_;
     bool overflow_ = false;
     std::vector<FrameFeatures> frames_;
     std::vector<std::uint8_t> silent_;
+    std::size_t blocksPerFrame_ = 0;
+    std::vector<float> blocks_;  // [frame][block]
 };
 
 // The second pass (AlignerConfig::fileAdaptationPriorFrames, Gauvain & Lee 1994): the file's
-// frames again, on templates moved toward what the first pass placed. The first pass's verdict
-// on each word stands: a word it left unplaced stays so, whatever the moved templates say (they
-// learnt from the placed words only, and would fit a wrong script better the second time).
-Alignment realign(const Alignment& first, const SpeakerAdaptation& own,
-                  std::span<const FrameFeatures> frames, std::span<const ScriptWord> script,
-                  const PhonemeSet& set, const ClassifierConfig& classifierConfig,
-                  const AlignerConfig& config, double timeScale) {
-    auto adapted = own.adapted(config.fileAdaptationPriorFrames);
-    adapted.jawNetwork.reset();  // neither the heard jaw nor the class network is used here
-    adapted.classNetwork.reset();
-    FrameClassifier classifier(adapted, set, classifierConfig);
+// frames again, on templates moved toward what the first pass placed (`measured`: the set the
+// first pass classified with). The energy gate is the first pass's: it depends on the frames'
+// levels alone. The first pass's verdict on each word stands: a word it left unplaced stays so,
+// whatever the moved templates say (they learnt from the placed words only, and would fit a
+// wrong script better the second time).
+Alignment realign(const Alignment& first, const SpeakerAdaptation& own, const KeptFrames& kept,
+                  const TemplateSet& measured, std::span<const ScriptWord> script,
+                  const PhonemeSet& set, const AlignerConfig& config, double timeScale) {
+    const auto adapted = own.adapted(config.fileAdaptationPriorFrames);
+    AdaptedDistances distances(adapted, measured, set);
     ForcedAligner aligner(script, set, adapted.analysis.hopSeconds, timeScale, config);
+    const auto frames = kept.frames();
     aligner.expectFrames(static_cast<std::int64_t>(frames.size()));
-    for (const auto& frame : frames) {
-        const auto label = classifier.classify(frame);
-        aligner.push(label.time, classifier.distances(), label.silent);
-    }
+    for (std::size_t i = 0; i < frames.size(); ++i)
+        aligner.push(frames[i].time, distances(frames[i], kept.blocks(i)), kept.silent()[i]);
     auto second = aligner.finish();
     if (!second.complete || second.words.size() != first.words.size()) return first;
     for (std::size_t i = 0; i < second.words.size(); ++i)
@@ -236,15 +258,21 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     const TemplateSet& first = start ? *start : base;
     StreamingAnalyzer analyzer(first, set, decoder.sampleRate(), config);
     ForcedAligner aligner(script, set, first.analysis.hopSeconds, r.timeScale, alignerConfig);
-    if (timing.durationSeconds > 0)
-        aligner.expectFrames(std::llround(timing.durationSeconds / first.analysis.hopSeconds));
+    // The frames expected (the analyser's count can differ by its edge frames).
+    const auto expected = std::llround(timing.durationSeconds / first.analysis.hopSeconds);
+    if (timing.durationSeconds > 0) aligner.expectFrames(expected);
     const bool adapting = alignerConfig.fileAdaptationPriorFrames > 0 || speaker;
     KeptFrames kept(adapting ? static_cast<std::size_t>(alignerConfig.fileAdaptationMaxSeconds /
                                                         first.analysis.hopSeconds)
                              : 0);
+    if (adapting) analyzer.recordBlockDistances();
+    const auto room = static_cast<std::size_t>(expected) + 2;
+    kept.reserve(room, analyzer.blockDistances().size());
+    r.levels.db.reserve(room);
+    r.levels.jaw.reserve(room);
     std::size_t speechFrames = 0;
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
-        if (adapting) kept.add(f.features, f.label.silent);
+        if (adapting) kept.add(f.features, f.label.silent, analyzer.blockDistances());
         aligner.push(f.label.time, analyzer.templateDistances(), f.label.silent);
         speechFrames += !f.label.silent;
         r.levels.add(f.label.time, f.label.energyDb);
@@ -266,8 +294,8 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
         SpeakerAdaptation own(base);
         if (speaker) own.add(*speaker);
         own.add(kept.frames(), placedSegments(r.alignment), kept.silent());
-        r.alignment = realign(r.alignment, own, kept.frames(), script, set, config.classifier,
-                              alignerConfig, r.timeScale);
+        r.alignment =
+            realign(r.alignment, own, kept, first, script, set, alignerConfig, r.timeScale);
     }
 
     const std::string name = decoder.name();

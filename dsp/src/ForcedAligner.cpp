@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "AlignmentGraph.hpp"
 #include "AlignmentPath.hpp"
+#include "AlignmentSweep.hpp"
 
 namespace lipsyncd::dsp {
 
@@ -20,6 +22,33 @@ constexpr float kSilentExcessDb = 3.0f;
 // The input's expected length in frames is the file's duration over the hop: the analyser's
 // count can differ by its edge frames.
 constexpr std::int64_t kFrameSlack = 2;
+
+// The first node of [from, to] with the least cost (-1: none finite), as a scan keeping the
+// first strictly lower value finds it: four such scans side by side, over every fourth node,
+// then the least of their four (the first node on a tie).
+using Costs4 = float __attribute__((vector_size(4 * sizeof(float))));
+using Nodes4 = int __attribute__((vector_size(4 * sizeof(int))));
+
+int firstBest(std::span<const float> cost, int from, int to) {
+    Costs4 least = kNever - Costs4{};
+    Nodes4 at = -1 - Nodes4{}, node = from + Nodes4{0, 1, 2, 3};
+    int n = from;
+    for (; n + 3 <= to; n += 4, node += 4) {
+        Costs4 v;
+        std::memcpy(&v, &cost[n], sizeof v);
+        const Nodes4 lower = v < least;
+        least = lower ? v : least;
+        at = lower ? node : at;
+    }
+    int first = -1;
+    float best = kNever;
+    for (int k = 0; k < 4; ++k)
+        if (least[k] < best || (least[k] == best && at[k] >= 0 && at[k] < first))
+            best = least[k], first = at[k];
+    for (; n <= to; ++n)  // the last few, after every node above
+        if (cost[n] < best) best = cost[n], first = n;
+    return first;
+}
 }  // namespace
 
 struct ForcedAligner::State {
@@ -29,12 +58,13 @@ struct ForcedAligner::State {
           set(&s),
           hop(hopSeconds),
           config(c),
-          path(script, graph, s, hopSeconds, c) {
+          path(script, graph, s, hopSeconds, c),
+          sweep(graph, s.size()) {
         const auto n = graph.nodes.size();
         delta.assign(n, kNever);
         next.assign(n, kNever);
+        arg.assign(n, -1);
         delta[0] = 0;  // the start node, before the first frame
-        emission.assign(s.size(), 0);
     }
 
     // Per-frame data the window keeps: back-pointers for the active nodes, and the excess
@@ -48,23 +78,22 @@ struct ForcedAligner::State {
     void scoreFrame(std::span<const float> distances, bool silent, std::vector<float>& excess);
     void step();
     int ancestor(std::int64_t frame, int node, std::int64_t atFrame) const;
+    void ancestors(std::int64_t frame, std::span<int> nodes, std::int64_t atFrame) const;
     void commit(std::int64_t keepFrames);
     int commitFrom() const;
     void emitPath(std::int64_t lastFrame, int node);
     void dropFront(std::int64_t frames);
-    float emit(const AlignmentNode& n) const {
-        if (n.kind == AlignmentNode::Kind::Filler) return n.frameCost;
-        return n.silentOnly && !frameSilent ? kNever : emission[n.phoneme];
-    }
 
     AlignmentGraph graph;
     const PhonemeSet* set;
     double hop;
     AlignerConfig config;
     AlignmentPath path;
-    std::vector<float> delta, next, emission;
-    bool frameSilent = false;  // the frame being scored is below the energy gate
-    int lo = 0, hi = 0;        // active nodes after the last frame
+    AlignmentSweep sweep;
+    std::vector<float> delta, next;  // per node: cost of the best path there, last frame and this
+    std::vector<std::int32_t> arg;   // per node: where its best path came from this frame
+    std::vector<int> alive, traced;  // commit(): the active nodes, and where their paths were
+    int lo = 0, hi = 0;              // active nodes after the last frame
     std::vector<Row> rows;
     std::vector<std::int32_t> back;
     std::vector<float> excess;
@@ -76,7 +105,7 @@ struct ForcedAligner::State {
 
 void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool silent,
                                       std::vector<float>& excessOut) {
-    frameSilent = silent;
+    const auto emission = sweep.classCosts();
     const std::size_t classes = set->size();
     float nearest = kNever;
     for (std::size_t c = 0; c < classes && c < distances.size(); ++c)
@@ -101,59 +130,28 @@ void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool sil
         emission[c] = cost;
         excessOut.push_back(ex);
     }
+    sweep.setSilent(silent);
 }
 
 void ForcedAligner::State::step() {
     const int from = lo, to = graph.reach[hi];
-    float best = kNever;
-    int bestNode = -1;
-    std::vector<std::int32_t>& bp = back;
-    const std::size_t offset = bp.size();
-    bp.resize(offset + static_cast<std::size_t>(to - from + 1), -1);
-    for (int n = from; n <= to; ++n) {
-        const auto& node = graph.nodes[n];
-        float in = kNever;
-        int arg = -1;
-        if (std::isfinite(node.loopCost) && delta[n] < kNever) {
-            in = delta[n] + node.loopCost;
-            arg = n;
-        }
-        for (int e = node.firstEdge; e < node.firstEdge + node.edgeCount; ++e) {
-            const auto& edge = graph.edges[e];
-            if (edge.from < lo || edge.from > hi) continue;
-            const float v = delta[edge.from] + graph.nodes[edge.from].exitCost + edge.cost;
-            if (v < in) {
-                in = v;
-                arg = edge.from;
-            }
-        }
-        if (arg < 0) continue;
-        next[n] = in + emit(node);
-        bp[offset + (n - from)] = arg;
-        if (next[n] < best) {
-            best = next[n];
-            bestNode = n;
-        }
-    }
+    sweep.relax(delta, lo, hi, from, to, next, arg);
+    const int bestNode = firstBest(next, from, to);
     // Pause and filler nodes loop at a finite cost, so some node is always reachable.
     if (bestNode < 0) throw std::logic_error("forced alignment: no node reachable");
-    std::fill(delta.begin() + lo, delta.begin() + hi + 1, kNever);
-    // Keep what lies within the beam, and at most maxActiveNodes around the best.
+    // Keep what lies within the beam, and at most maxActiveNodes around the best: a select per
+    // node (a branch on the beam would be mispredicted often), then the kept range's ends.
     const int half = std::max(1, config.maxActiveNodes / 2);
     const int keepLo = std::max(from, bestNode - half), keepHi = std::min(to, bestNode + half);
-    int newLo = -1, newHi = -1;
-    for (int n = from; n <= to; ++n) {
-        if (n >= keepLo && n <= keepHi && next[n] <= best + config.beam) {
-            delta[n] = next[n];
-            if (newLo < 0) newLo = n;
-            newHi = n;
-        }
-        next[n] = kNever;
-    }
+    const float bound = next[bestNode] + config.beam;
+    for (int n = from; n < keepLo; ++n) delta[n] = kNever;
+    for (int n = keepLo; n <= keepHi; ++n) delta[n] = next[n] <= bound ? next[n] : kNever;
+    for (int n = keepHi + 1; n <= to; ++n) delta[n] = kNever;
+    int newLo = from, newHi = to;  // the best node is kept: both scans stop
+    while (!(delta[newLo] < kNever)) ++newLo;
+    while (!(delta[newHi] < kNever)) --newHi;
     // Only the kept nodes' back-pointers can be followed later.
-    std::copy(bp.begin() + offset + (newLo - from), bp.begin() + offset + (newHi - from) + 1,
-              bp.begin() + offset);
-    bp.resize(offset + static_cast<std::size_t>(newHi - newLo + 1));
+    back.insert(back.end(), arg.begin() + newLo, arg.begin() + newHi + 1);
     rows.back().lo = newLo;
     rows.back().count = newHi - newLo + 1;
     lo = newLo;
@@ -167,6 +165,16 @@ int ForcedAligner::State::ancestor(std::int64_t frame, int node, std::int64_t at
         node = back[row.back + static_cast<std::size_t>(node - row.lo)];
     }
     return node;
+}
+
+// ancestor() for many nodes at once, in place: walked back together, a frame at a time (one
+// path's walk alone is a chain of dependent loads).
+void ForcedAligner::State::ancestors(std::int64_t frame, std::span<int> nodes,
+                                     std::int64_t atFrame) const {
+    for (std::int64_t f = frame; f > atFrame; --f) {
+        const auto& row = rows[static_cast<std::size_t>(f - windowStart)];
+        for (auto& node : nodes) node = back[row.back + static_cast<std::size_t>(node - row.lo)];
+    }
 }
 
 void ForcedAligner::State::emitPath(std::int64_t lastFrame, int node) {
@@ -231,8 +239,13 @@ void ForcedAligner::State::commit(std::int64_t keepFrames) {
     const int bestNode = commitFrom();
     const int anchor = ancestor(last, bestNode, upTo);
     emitPath(upTo, anchor);
+    alive.clear();
     for (int n = lo; n <= hi; ++n)
-        if (delta[n] < kNever && ancestor(last, n, upTo) != anchor) delta[n] = kNever;
+        if (delta[n] < kNever) alive.push_back(n);
+    traced = alive;
+    ancestors(last, traced, upTo);
+    for (std::size_t i = 0; i < alive.size(); ++i)
+        if (traced[i] != anchor) delta[alive[i]] = kNever;
     while (lo < hi && !(delta[lo] < kNever)) ++lo;
     while (hi > lo && !(delta[hi] < kNever)) --hi;
     dropFront(upTo - windowStart + 1);

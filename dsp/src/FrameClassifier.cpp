@@ -37,6 +37,10 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
     reset();
 }
 
+void FrameClassifier::recordBlockDistances() {
+    blockDistances_.assign(matrix_->blocks(), std::numeric_limits<float>::infinity());
+}
+
 void FrameClassifier::reset() {
     noiseFloorDb_ = kInitialNoiseFloorDb;
     peakDb_ = -120;
@@ -103,6 +107,8 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         // The templates' own distances (templateDistances()) too, not the last frame's.
         std::fill(templateDistances_.begin(), templateDistances_.end(),
                   std::numeric_limits<float>::infinity());
+        std::fill(blockDistances_.begin(), blockDistances_.end(),
+                  std::numeric_limits<float>::infinity());
         label.phoneme = label.runnerUp = sil_;
         label.distance = label.runnerUpDistance = 0;
         label.confidence = 1;
@@ -110,10 +116,11 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         return label;
     }
     matrix_->transform(frame.spectrum, scaledFrame_);
-    matrix_->nearest(scaledFrame_, distances_);
-    const auto features = static_cast<float>(matrix_->features());
-    for (auto& d : distances_)  // weighted RMS difference, in dB
-        if (std::isfinite(d)) d = std::sqrt(d / features);
+    if (blockDistances_.empty())
+        matrix_->nearest(scaledFrame_, distances_);
+    else
+        matrix_->nearest(scaledFrame_, distances_, blockDistances_);
+    matrix_->toRms(distances_);  // weighted RMS difference, in dB
 
     if (classNetwork_) addClassNetwork(frame);
 

@@ -11,21 +11,50 @@ namespace lipsyncd::dsp {
 SpeakerAdaptation::SpeakerAdaptation(TemplateSet base)
     : base_(std::move(base)), weighting_(std::make_shared<const FeatureWeighting>(base_)) {
     const std::size_t features = weighting_->features();
+    std::vector<float> x(features);
     for (const auto& cls : base_.classes) {
         classStart_.push_back(counts_.size());
-        for (const auto& spectrum : cls.spectra) {
-            weighted_.resize(weighted_.size() + features);
-            weighting_->transform(spectrum, std::span(weighted_).last(features));
+        const std::size_t at = weighted_.size(), count = cls.spectra.size();
+        weighted_.resize(at + count * features);
+        for (std::size_t t = 0; t < count; ++t) {
+            weighting_->transform(cls.spectra[t], x);
+            for (std::size_t k = 0; k < features; ++k) weighted_[at + k * count + t] = x[k];
             counts_.push_back(0.0);
         }
     }
+    classStart_.push_back(counts_.size());
     sums_.assign(counts_.size() * features, 0.0);
+}
+
+// The template of class `cls` nearest to the weighted frame x (the first of equal distances).
+// Each template's sum is formed in double, feature after feature, as one template at a time
+// would form it; the loop over the class's templates is the one that runs side by side.
+std::size_t SpeakerAdaptation::nearestOfClass(std::span<const float> x, std::size_t cls,
+                                              std::vector<double>& distances) const {
+    const std::size_t first = classStart_[cls], count = classStart_[cls + 1] - first;
+    const float* w = &weighted_[first * x.size()];
+    distances.assign(count, 0.0);
+    double* d = distances.data();
+    for (std::size_t k = 0; k < x.size(); ++k) {
+        const double xk = x[k];
+        const float* row = w + k * count;
+        for (std::size_t t = 0; t < count; ++t) {
+            const double e = xk - row[t];
+            d[t] += e * e;
+        }
+    }
+    std::size_t best = first;
+    double bestDistance = std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t < count; ++t)
+        if (d[t] < bestDistance) bestDistance = d[t], best = first + t;
+    return best;
 }
 
 void SpeakerAdaptation::add(std::span<const FrameFeatures> frames, const PhonemeSchedule& segments,
                             std::span<const std::uint8_t> silent) {
     const std::size_t features = weighting_->features();
     std::vector<float> x(features);
+    std::vector<double> distances;
     std::size_t f = 0;
     for (const auto& seg : segments) {
         const auto cls = std::find_if(base_.classes.begin(), base_.classes.end(),
@@ -34,25 +63,14 @@ void SpeakerAdaptation::add(std::span<const FrameFeatures> frames, const Phoneme
         std::size_t end = f;
         while (end < frames.size() && frames[end].time < seg.end) ++end;
         if (seg.phoneme == "sil" || cls == base_.classes.end() || end < f + 3) continue;
-        const std::size_t first =
-            classStart_[static_cast<std::size_t>(cls - base_.classes.begin())];
+        const auto c = static_cast<std::size_t>(cls - base_.classes.begin());
         // The edge frames straddle two sounds.
         for (std::size_t i = f + 1; i + 1 < end; ++i) {
             const auto& frame = frames[i];
             if (!frame.valid || frame.spectrum.size() != features) continue;
             if (i < silent.size() && silent[i]) continue;
             weighting_->transform(frame.spectrum, x);
-            std::size_t best = first;
-            double bestDistance = std::numeric_limits<double>::infinity();
-            for (std::size_t t = first; t < first + cls->spectra.size(); ++t) {
-                const float* w = &weighted_[t * features];
-                double d = 0;
-                for (std::size_t k = 0; k < features; ++k) {
-                    const double e = static_cast<double>(x[k]) - w[k];
-                    d += e * e;
-                }
-                if (d < bestDistance) bestDistance = d, best = t;
-            }
+            const std::size_t best = nearestOfClass(x, c, distances);
             double* sum = &sums_[best * features];
             for (std::size_t k = 0; k < features; ++k) sum[k] += frame.spectrum[k];
             counts_[best] += 1;

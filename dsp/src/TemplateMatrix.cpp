@@ -56,11 +56,26 @@ namespace {
 using Lanes = FloatLanes;
 static_assert(TemplateMatrix::kLanes == kVectorLanes, "a block is one vector of lanes");
 
+// Beside the distances: each block's least distance recorded, or some blocks' taken as known.
+struct BlockRecord {
+    float* write = nullptr;               // per block, or null
+    const std::uint8_t* known = nullptr;  // per block: 1 where `values` holds it, or null
+    const float* values = nullptr;
+};
+
+// The least of the lanes that are numbers, as the running minimum below keeps them.
+float leastLane(const Lanes& v) {
+    float m = std::numeric_limits<float>::infinity();
+    for (std::size_t lane = 0; lane < TemplateMatrix::kLanes; ++lane) m = v[lane] < m ? v[lane] : m;
+    return m;
+}
+
 // Squared distances from x to the eight templates of one block. Feature f goes into partial
 // sum f mod 8, as in a row loop of eight partial sums.
 LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features,
                                             const float* blocks, const int* blockClass,
-                                            std::size_t blockCount, float* out) {
+                                            std::size_t blockCount, BlockRecord record,
+                                            float* out) {
     const std::size_t stride = features * TemplateMatrix::kLanes;
     const std::size_t whole = features / 8 * 8;
     for (std::size_t block = 0; block < blockCount;) {
@@ -68,7 +83,12 @@ LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features
         Lanes best;
         for (std::size_t lane = 0; lane < TemplateMatrix::kLanes; ++lane)
             best[lane] = std::numeric_limits<float>::infinity();
+        float known = std::numeric_limits<float>::infinity();
         for (; block < blockCount && blockClass[block] == cls; ++block) {
+            if (record.known && record.known[block]) {
+                known = std::min(known, record.values[block]);
+                continue;
+            }
             const float* t = blocks + block * stride;
             Lanes acc[8] = {};
             std::size_t f = 0;
@@ -91,11 +111,12 @@ LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features
             const Lanes sum =
                 ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
             best = sum < best ? sum : best;
+            if (record.write) record.write[block] = leastLane(sum);
         }
         float m = best[0];
         for (std::size_t lane = 1; lane < TemplateMatrix::kLanes; ++lane)
             m = std::min(m, best[lane]);
-        out[cls] = m;
+        out[cls] = std::min(m, known);
     }
 }
 }  // namespace
@@ -103,7 +124,38 @@ LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features
 void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out) const {
     std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
     nearestPerClass(scaledFrame.data(), features(), blocks_.data(), blockClass_.data(),
-                    blockClass_.size(), out.data());
+                    blockClass_.size(), {}, out.data());
+}
+
+void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out,
+                             std::span<float> record) const {
+    std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
+    nearestPerClass(scaledFrame.data(), features(), blocks_.data(), blockClass_.data(),
+                    blockClass_.size(), {record.data()}, out.data());
+}
+
+void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out,
+                             std::span<const std::uint8_t> same,
+                             std::span<const float> record) const {
+    std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
+    nearestPerClass(scaledFrame.data(), features(), blocks_.data(), blockClass_.data(),
+                    blockClass_.size(), {nullptr, same.data(), record.data()}, out.data());
+}
+
+std::vector<std::uint8_t> TemplateMatrix::sameBlocks(const TemplateMatrix& other) const {
+    std::vector<std::uint8_t> same(blocks(), 0);
+    if (!(weighting_ == other.weighting_) || blockClass_ != other.blockClass_) return same;
+    const std::size_t stride = features() * kLanes;
+    for (std::size_t b = 0; b < blocks(); ++b)
+        same[b] = std::memcmp(&blocks_[b * stride], &other.blocks_[b * stride],
+                              stride * sizeof(float)) == 0;
+    return same;
+}
+
+void TemplateMatrix::toRms(std::span<float> distances) const {
+    const auto n = static_cast<float>(features());
+    for (auto& d : distances)
+        if (std::isfinite(d)) d = std::sqrt(d / n);
 }
 
 }  // namespace lipsyncd::dsp

@@ -8,9 +8,14 @@
 // Each template's sum is formed exactly as a row-by-row loop with eight partial sums forms it
 // (feature f into partial sum f mod 8, in order; the partial sums added as
 // ((0+4)+(1+5))+((2+6)+(3+7))), so the distances do not depend on the layout.
+//
+// A second pass over the same frames on a set where only some templates moved (SpeakerAdaptation)
+// need not measure the blocks that did not: the first pass records each block's least distance,
+// and the second takes those blocks' from the record (a minimum is the same in any order).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <lipsyncd/dsp.hpp>
 #include <span>
 #include <vector>
@@ -27,6 +32,7 @@ class FeatureWeighting {
     std::size_t features() const { return features_; }
     // `out` has features() values.
     void transform(std::span<const float> frame, std::span<float> out) const;
+    bool operator==(const FeatureWeighting&) const = default;
 
   private:
     std::size_t features_ = 0;
@@ -49,6 +55,19 @@ class TemplateMatrix {
     // Squared weighted distance from a scaled frame to the nearest template of each class,
     // indexed by phoneme set index; +inf for classes without templates.
     void nearest(std::span<const float> scaledFrame, std::span<float> out) const;
+    // The same, also writing each block's least squared distance to `record` (blocks() values).
+    void nearest(std::span<const float> scaledFrame, std::span<float> out,
+                 std::span<float> record) const;
+    // The same, taking the blocks `same` marks from `record`, made by the matrix `same` was
+    // made against (sameBlocks) for the same frame.
+    void nearest(std::span<const float> scaledFrame, std::span<float> out,
+                 std::span<const std::uint8_t> same, std::span<const float> record) const;
+    std::size_t blocks() const { return blockClass_.size(); }
+    // Per block: 1 where `other` holds the same templates of the same class, weighed the same,
+    // so that its record of a frame holds this matrix's distances for that block.
+    std::vector<std::uint8_t> sameBlocks(const TemplateMatrix& other) const;
+    // Squared distances (nearest()'s) to the weighted RMS difference in dB, in place.
+    void toRms(std::span<float> distances) const;
 
   private:
     FeatureWeighting weighting_;

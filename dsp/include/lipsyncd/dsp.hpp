@@ -374,6 +374,11 @@ class FrameClassifier {
     std::span<const float> templateDistances() const {
         return classNetwork_ ? std::span<const float>(templateDistances_) : distances_;
     }
+    // From now on, each frame's least squared distance per block of eight templates
+    // (TemplateMatrix) is kept, for a second pass on templates of which only some moved to take
+    // the others' from (realign in AlignFile.cpp). +inf for a frame without a spectrum.
+    void recordBlockDistances();
+    std::span<const float> blockDistances() const { return blockDistances_; }
     void reset();
 
   private:
@@ -384,7 +389,8 @@ class FrameClassifier {
     std::shared_ptr<const TemplateMatrix> matrix_;  // every template, laid out for the distances
     std::vector<float> scaledFrame_;
     std::vector<float> distances_;
-    std::vector<float> jawOf_;  // per class: its jaw height (0 where the set gives none)
+    std::vector<float> blockDistances_;  // empty unless recordBlockDistances()
+    std::vector<float> jawOf_;           // per class: its jaw height (0 where the set gives none)
     std::optional<JawNetwork> jawNetwork_;
     void addClassNetwork(const FrameFeatures& frame);
     std::optional<ClassNetwork> classNetwork_;
@@ -583,6 +589,9 @@ class StreamingAnalyzer {
     // (FrameClassifier::distances()); valid only inside the sink.
     std::span<const float> distances() const { return classifier_.distances(); }
     std::span<const float> templateDistances() const { return classifier_.templateDistances(); }
+    // FrameClassifier::recordBlockDistances() and blockDistances().
+    void recordBlockDistances() { classifier_.recordBlockDistances(); }
+    std::span<const float> blockDistances() const { return classifier_.blockDistances(); }
 
   private:
     void onFeatures(const FrameFeatures& features);
@@ -873,10 +882,15 @@ class SpeakerAdaptation {
     void load(const std::filesystem::path& file);
 
   private:
+    std::size_t nearestOfClass(std::span<const float> x, std::size_t cls,
+                               std::vector<double>& distances) const;
+
     TemplateSet base_;
     std::shared_ptr<const FeatureWeighting> weighting_;  // the classifier's distance
-    std::vector<float> weighted_;                        // [template][feature]: the base, weighted
-    std::vector<std::size_t> classStart_;  // per class of base_: its first template's index
+    // The base, weighted: per class, [feature][template of the class], so that one feature
+    // serves every template of the class at once.
+    std::vector<float> weighted_;
+    std::vector<std::size_t> classStart_;  // per class of base_, and one past: first template
     std::vector<double> sums_;             // [template][feature]
     std::vector<double> counts_;           // [template]
     std::size_t frames_ = 0;
