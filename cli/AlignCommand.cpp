@@ -6,6 +6,7 @@
 #include <lipsyncd/dsp.hpp>
 #include <lipsyncd/tts.hpp>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "AlignerOptions.hpp"
@@ -29,6 +30,7 @@ struct AlignOptions {
     AlignerOptions aligner;
     FrontEndOptions frontEnd;
     RuntimeOptions runtime;
+    std::string speaker;  // a speaker file (lipsyncd's speaker_file): read, then written back
     bool quiet = false;
 };
 
@@ -62,10 +64,18 @@ void writeJson(std::ostream& out, const dsp::AlignFileResult& r) {
 void runAlign(const AlignOptions& o) {
     const std::string text = o.textFile.empty() ? o.text : readTextFile(o.textFile);
     const auto templates = o.frontEnd.loadTemplates();
+    // The speaker's voice from the lines before (a file that does not exist yet: none), and
+    // this line added to it.
+    std::optional<dsp::SpeakerAdaptation> speaker;
+    if (!o.speaker.empty()) {
+        speaker.emplace(templates);
+        if (std::filesystem::exists(o.speaker)) speaker->load(o.speaker);
+    }
     EspeakSynthesizer synth;
-    const auto r =
-        alignText(synth, o.input, text, o.voice, templates, o.frontEnd.config(), o.aligner.config,
-                  o.frontEnd.decode(), o.frontEnd.raw(), o.aligner.reductions);
+    const auto r = alignText(synth, o.input, text, o.voice, templates, o.frontEnd.config(),
+                             o.aligner.config, o.frontEnd.decode(), o.frontEnd.raw(),
+                             o.aligner.reductions, speaker ? &*speaker : nullptr);
+    if (speaker) speaker->save(o.speaker);
     for (const auto& w : r.warnings) std::cerr << "lipsync align: warning: " << w << '\n';
     if (!o.quiet) {
         const auto placed = std::count_if(r.alignment.words.begin(), r.alignment.words.end(),
@@ -109,6 +119,9 @@ void addAlignCommand(CLI::App& app) {
                     "espeak-ng voice whose reading of the words to follow (its language)")
         ->capture_default_str();
     o->aligner.addTo(*cmd);
+    cmd->add_option("--speaker", o->speaker,
+                    "A speaker file: align on the voice the earlier lines taught it, and add this "
+                    "line's (created when missing; lipsyncd's speaker_file has the same format)");
     cmd->add_flag("--quiet,-q", o->quiet, "No summary on stderr");
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, true);

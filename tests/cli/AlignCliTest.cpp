@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/dsp.hpp>
 #include <nlohmann/json.hpp>
@@ -88,6 +89,40 @@ TEST(AlignCli, TheLabellingScriptKeepsOnlyConfidentLabels) {
     const auto usage =
         runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh"});
     EXPECT_EQ(usage.exitCode, 2);
+}
+
+std::string slurp(const fs::path& file) {
+    std::ifstream in(file);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// `align --speaker FILE`: a show's lines aligned one run at a time carry the voice in a file,
+// as lipsyncd's speaker_file does; a broken file is an error naming it.
+TEST(AlignCli, ASpeakerFileCarriesTheVoiceFromRunToRun) {
+    const auto dir = scratchDir("cli_align_speaker");
+    const std::string first = "The old lighthouse keeper waved at every ship.";
+    const std::string second = "Nobody knew why the clock stopped at midnight.";
+    speak(dir, "first", first, "en-us+klatt3", "");
+    speak(dir, "second", second, "en-us+klatt3", "");
+    const auto voice = dir / "voice.json";
+    const auto align = [&](const std::string& name, const std::string& text, bool carried) {
+        std::vector<std::string> args = {"align", (dir / (name + ".wav")).string(), "--text", text,
+                                         "-s",    (dir / (name + ".tsv")).string(), "-q"};
+        if (carried) args.insert(args.end(), {"--speaker", voice.string()});
+        return runLipsync(args);
+    };
+    ASSERT_EQ(align("second", second, false).exitCode, 0);
+    const auto cold = slurp(dir / "second.tsv");
+    ASSERT_EQ(align("first", first, true).exitCode, 0);
+    ASSERT_TRUE(fs::exists(voice));
+    const auto r = align("second", second, true);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(slurp(dir / "second.tsv"), cold) << "the second line ignored the first's voice";
+
+    std::ofstream(voice) << "{\"format\": \"lipsyncd-speaker\", \"version\": 1}\n";
+    const auto broken = align("second", second, true);
+    EXPECT_EQ(broken.exitCode, 1);
+    EXPECT_NE(broken.err.find(voice.string()), std::string::npos) << broken.err;
 }
 
 // `eval --adapt-speaker` without --align: the service's adapt_speaker for files played without
