@@ -151,9 +151,8 @@ struct Evaluator {
     std::pair<PhonemeSchedule, LevelTrack> analyse(const CorpusItem& item,
                                                    dsp::SpeakerAdaptation* speaker) const {
         const auto own =
-            speaker && speaker->frames() > 0
-                ? std::optional(speaker->adapted(o.aligner.config.speakerAdaptationPriorFrames))
-                : std::nullopt;
+            speaker ? speaker->adaptedIfHeard(o.aligner.config.speakerAdaptationPriorFrames)
+                    : std::nullopt;
         auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
                                   o.frontEnd.decode(), std::nullopt);
         if (speaker && wordsBeside(item.audio)) align(item, speaker);

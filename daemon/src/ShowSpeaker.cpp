@@ -54,8 +54,7 @@ std::string ShowSpeaker::save(const Lesson& lesson) {
 }
 
 dsp::TemplateSet ShowSpeaker::templates() const {
-    const std::lock_guard lock(mutex_);
-    if (voice_.frames() == 0) return voice_.base();
+    const std::lock_guard lock(mutex_);  // (before any line: the base, as adapted() leaves it)
     return voice_.adapted(dsp::AlignerConfig{}.speakerAdaptationPriorFrames);
 }
 

@@ -251,10 +251,8 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     auto decoder = AudioDecoder::open(file, decode, raw);
     // A speaker carried from line to line: this line starts from the voice heard so far.
     const TemplateSet& base = speaker ? speaker->base() : templates;
-    const auto start =
-        speaker && speaker->frames() > 0
-            ? std::optional(speaker->adapted(alignerConfig.speakerAdaptationPriorFrames))
-            : std::nullopt;
+    const auto start = speaker ? speaker->adaptedIfHeard(alignerConfig.speakerAdaptationPriorFrames)
+                               : std::nullopt;
     const TemplateSet& first = start ? *start : base;
     StreamingAnalyzer analyzer(first, set, decoder.sampleRate(), config);
     ForcedAligner aligner(script, set, first.analysis.hopSeconds, r.timeScale, alignerConfig);

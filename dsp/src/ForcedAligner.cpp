@@ -160,10 +160,7 @@ void ForcedAligner::State::step() {
 
 // The node a path in `node` at `frame` passed through at `atFrame` (≤ frame, in the window).
 int ForcedAligner::State::ancestor(std::int64_t frame, int node, std::int64_t atFrame) const {
-    for (std::int64_t f = frame; f > atFrame; --f) {
-        const auto& row = rows[static_cast<std::size_t>(f - windowStart)];
-        node = back[row.back + static_cast<std::size_t>(node - row.lo)];
-    }
+    ancestors(frame, std::span(&node, 1), atFrame);
     return node;
 }
 

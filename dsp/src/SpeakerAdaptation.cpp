@@ -103,4 +103,9 @@ TemplateSet SpeakerAdaptation::adapted(float priorFrames) const {
     return out;
 }
 
+std::optional<TemplateSet> SpeakerAdaptation::adaptedIfHeard(float priorFrames) const {
+    if (frames_ == 0) return std::nullopt;
+    return adapted(priorFrames);
+}
+
 }  // namespace lipsyncd::dsp

@@ -56,9 +56,8 @@ PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem:
     }
     // Recognised on the speaker's voice as heard so far, when lines with words have taught it.
     const auto own =
-        speaker && speaker->frames() > 0
-            ? std::optional(speaker->adapted(dsp::AlignerConfig{}.speakerAdaptationPriorFrames))
-            : std::nullopt;
+        speaker ? speaker->adaptedIfHeard(dsp::AlignerConfig{}.speakerAdaptationPriorFrames)
+                : std::nullopt;
     auto r = dsp::analyzeFile(audio, own ? *own : templates, PhonemeSet::common(), {}, decode);
     if (levels) *levels = std::move(r.levels);
     return std::move(r.schedule);

@@ -871,6 +871,8 @@ class SpeakerAdaptation {
     void add(const SpeakerAdaptation& other);  // another's frames (the same base set)
     // The base set with every template heard moved, under a prior worth `priorFrames` frames.
     TemplateSet adapted(float priorFrames) const;
+    // adapted() once any frame has been learnt; before that nothing (the base serves as it is).
+    std::optional<TemplateSet> adaptedIfHeard(float priorFrames) const;
     std::size_t frames() const { return frames_; }  // frames learnt so far
     const TemplateSet& base() const { return base_; }
     // What has been learnt, kept in a file across runs (lipsyncd's speaker_file): the templates
