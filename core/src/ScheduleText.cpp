@@ -150,10 +150,30 @@ PhonemeSchedule readScheduleFile(const std::filesystem::path& file,
     return readSchedule(in, file.string(), options, warnings);
 }
 
+namespace {
+
+// The segments as written: times in whole milliseconds, and a segment that rounds to no length
+// (a sliver at a file's end, e.g. 0.9975 to 0.998 s) left out, so that its neighbours still
+// touch and every file written reads back (the reader refuses a segment that ends where it
+// starts).
+std::vector<PhonemeSegment> asWritten(std::span<const PhonemeSegment> schedule) {
+    std::vector<PhonemeSegment> out;
+    out.reserve(schedule.size());
+    for (const auto& s : schedule) {
+        const double start = std::round(s.start * 1000) / 1000;
+        const double end = std::round(s.end * 1000) / 1000;
+        if (end <= start) continue;
+        out.push_back({start, end, s.phoneme, s.confidence});
+    }
+    return out;
+}
+
+}  // namespace
+
 void writeSchedule(std::ostream& out, std::span<const PhonemeSegment> schedule,
                    bool withConfidence) {
     out << std::fixed;
-    for (const auto& s : schedule) {
+    for (const auto& s : asWritten(schedule)) {
         out << std::setprecision(3) << s.start << '\t' << s.end << '\t' << s.phoneme;
         if (withConfidence) out << '\t' << std::setprecision(2) << s.confidence;
         out << '\n';
@@ -162,9 +182,9 @@ void writeSchedule(std::ostream& out, std::span<const PhonemeSegment> schedule,
 
 void writeScheduleJson(std::ostream& out, std::span<const PhonemeSegment> schedule) {
     auto arr = nlohmann::json::array();
-    for (const auto& s : schedule)
-        arr.push_back({{"start", std::round(s.start * 1000) / 1000},
-                       {"end", std::round(s.end * 1000) / 1000},
+    for (const auto& s : asWritten(schedule))
+        arr.push_back({{"start", s.start},
+                       {"end", s.end},
                        {"phoneme", s.phoneme},
                        {"confidence", std::round(s.confidence * 100) / 100}});
     out << arr.dump(1) << '\n';

@@ -1,6 +1,7 @@
 #include <lipsyncd/core.hpp>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <sstream>
 
@@ -38,6 +39,23 @@ TEST(ScheduleText, RoundTripsThroughWriter) {
     EXPECT_EQ(parse(out.str()), in);
 }
 
+
+// An aligned file's last silence can be a sliver (0.9978 to 0.998 s): written in ms it would
+// end where it starts, a line the reader refuses (lipsync train failed on such a label file).
+TEST(ScheduleText, ASliverThatRoundsToNoLengthIsLeftOutSoTheFileReadsBack) {
+    const PhonemeSchedule in = {{0, 0.8384, "kg", 1}, {0.8384, 0.9978, "sh", 1},
+                                {0.9978, 0.998, "sil", 1}};
+    std::ostringstream out;
+    writeSchedule(out, in);
+    const auto back = parse(out.str());
+    ASSERT_EQ(back.size(), 2u);
+    EXPECT_DOUBLE_EQ(back[0].end, 0.838);
+    EXPECT_DOUBLE_EQ(back[1].start, 0.838);
+    EXPECT_DOUBLE_EQ(back[1].end, 0.998);
+    std::ostringstream json;
+    writeScheduleJson(json, in);
+    EXPECT_EQ(nlohmann::json::parse(json.str()).size(), 2u);
+}
 TEST(ScheduleText, MapsArpabetLabelsAndFillsGapsWithSilence) {
     const auto map = PhonemeMap::named("arpabet");
     ScheduleReadOptions o;
