@@ -39,12 +39,11 @@ TEST(ScheduleText, RoundTripsThroughWriter) {
     EXPECT_EQ(parse(out.str()), in);
 }
 
-
 // An aligned file's last silence can be a sliver (0.9978 to 0.998 s): written in ms it would
 // end where it starts, a line the reader refuses (lipsync train failed on such a label file).
 TEST(ScheduleText, ASliverThatRoundsToNoLengthIsLeftOutSoTheFileReadsBack) {
-    const PhonemeSchedule in = {{0, 0.8384, "kg", 1}, {0.8384, 0.9978, "sh", 1},
-                                {0.9978, 0.998, "sil", 1}};
+    const PhonemeSchedule in = {
+        {0, 0.8384, "kg", 1}, {0.8384, 0.9978, "sh", 1}, {0.9978, 0.998, "sil", 1}};
     std::ostringstream out;
     writeSchedule(out, in);
     const auto back = parse(out.str());
