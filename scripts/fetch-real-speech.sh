@@ -34,6 +34,7 @@ while read -r speaker kind source; do
     fillets:*) lang="${source#fillets:}" lang="${lang%%:*}"
                packages+=(fillets-ng-data "fillets-ng-data-$lang") ;;
     festvox-ru) packages+=(festvox-ru) ;;
+    tuxpaint:*) packages+=(tuxpaint-stamps-default) ;;
     *) echo "fetch-real-speech.sh: $speaker: unknown source '$source'" >&2; exit 1 ;;
   esac
 done <"$here/config/corpus/real-speakers.txt"

@@ -22,6 +22,10 @@ Labels:
   labelling time stays bounded and the voice still outweighs none of the others.
 - festvox-ru: the voice's own time-aligned phone labels (lab/*.lab), mapped by
   config/phonemes/festvox-ru.toml.
+- tuxpaint (tuxpaint-stamps-default): each stamp's description read aloud (NAME_desc_LANG.ogg,
+  44.1 kHz), its words in the stamp's NAME.txt (the `LANG.utf8=` line). Written as NAME.wav +
+  NAME.txt only, without labels: scripts/train-templates.sh labels them with the project's own
+  aligner (`lipsync align --voice LANG`), on templates trained without them.
 Items whose words are not in the dictionary, or that the aligner cannot fit, are skipped and
 counted. Reproducible: same packages, same tools, same files.
 """
@@ -151,6 +155,25 @@ def festvox_ru_items(root):
         yield lab.stem, base / "wav" / f"{lab.stem}.wav", None, segments, texts.get(lab.stem)
 
 
+# Items whose labels come from the project's own aligner later (train-templates.sh), not here.
+BY_ALIGNER = "aligner"
+
+
+def tuxpaint_items(root, lang):
+    base = root / "usr/share/tuxpaint/stamps"
+    suffix = f"_desc_{lang}.ogg"
+    for audio in sorted(base.rglob(f"*{suffix}")):
+        stem = audio.name[: -len(suffix)]
+        about = audio.parent / f"{stem}.txt"
+        if not about.exists():
+            continue
+        lines = about.read_text(encoding="utf-8", errors="replace").splitlines()
+        text = next((l.split("=", 1)[1].strip() for l in lines if l.startswith(f"{lang}.utf8=")), "")
+        if text:
+            name = "_".join(audio.parent.relative_to(base).parts + (stem,))
+            yield name, audio, BY_ALIGNER, None, text
+
+
 def items_of(root, source):
     kind, *args = source.split(":")
     if kind == "asterisk":
@@ -163,6 +186,8 @@ def items_of(root, source):
         return fillets_items(root, *args)
     if kind == "festvox-ru":
         return festvox_ru_items(root)
+    if kind == "tuxpaint":
+        return tuxpaint_items(root, *args)
     sys.exit(f"config/corpus/real-speakers.txt: unknown source '{source}'")
 
 
@@ -300,7 +325,12 @@ def main():
                 if args.subset and made >= args.subset:
                     break
                 wav, lab = folder / f"{name}.wav", folder / f"{name}.lab"
-                if lab.exists() and wav.exists():
+                if wav.exists() and (lab.exists() or words == BY_ALIGNER):
+                    write_text(folder / f"{name}.txt", text)
+                    made += 1
+                    continue
+                if words == BY_ALIGNER:
+                    convert(audio, wav)
                     write_text(folder / f"{name}.txt", text)
                     made += 1
                     continue

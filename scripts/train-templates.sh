@@ -28,13 +28,32 @@ rc=0
 [ "$rc" -eq 0 ] || { echo "train-templates.sh: the real training speakers are needed (fetch-real-speech.sh exit $rc)" >&2; exit 1; }
 
 folders=("$corpus")
-speakers=()
-while read -r speaker split _; do
+speakers=() by_aligner=()
+while read -r speaker split source; do
   case "$speaker" in ''|'#'*) continue ;; esac
   [ "$split" = train ] || continue
-  folders+=("$real/train/$speaker")
+  case "$source" in
+    tuxpaint:*) by_aligner+=("$speaker=${source#tuxpaint:}") ;;  # words only: labelled below
+    *) folders+=("$real/train/$speaker") ;;
+  esac
   speakers+=("$speaker")
 done <"$here/config/corpus/real-speakers.txt"
+
+# Speakers with words but no labels are labelled by the project's own aligner (issue 11: the
+# aligner is the labeller), on templates trained first from the labelled speech alone, so the
+# labels never depend on the set they go into: the same packages and build give the same file.
+if [ ${#by_aligner[@]} -gt 0 ]; then
+  labeller="$real/labeller-templates.json"
+  "$lipsync" train "${folders[@]}" --clusters 24 --jaw-hidden 0 --class-hidden 0 -o "$labeller" \
+    --description "Labeller: scripts/train-templates.sh's templates from labelled speech only"
+  for pair in "${by_aligner[@]}"; do
+    speaker="${pair%%=*}"
+    rm -rf "$real/aligned/$speaker"
+    "$here/scripts/label-with-aligner.sh" "$real/train/$speaker" "$real/aligned/$speaker" \
+      --voice "${pair#*=}" --templates "$labeller"
+    folders+=("$real/aligned/$speaker")
+  done
+fi
 
 # 24 cluster means per class: with real speakers in training, 16 / 20 / 24 gave 63.8 / 65.6 /
 # 67.6 % on the espeak-ng dev corpus and the worst real dev speaker stayed within a point.
