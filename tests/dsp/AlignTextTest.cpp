@@ -91,6 +91,31 @@ TEST(AlignText, EspeakSpeechBoundariesMatchItsOwnTimings) {
     EXPECT_GT(*std::max_element(r.levels.jaw.begin(), r.levels.jaw.end()), 0.5f);
 }
 
+// A puppet's lines in French, Spanish, Bulgarian or Romanian are aligned on the phonemes espeak-ng
+// reads in that language (config/phonemes/espeak-LANG.toml), as Russian and English are: every
+// word placed, and the boundaries where espeak-ng's own timings put them, although no French,
+// Bulgarian or Romanian speech trained the templates.
+TEST(AlignText, LinesInOtherLanguagesAreAlignedOnTheirOwnPhonemes) {
+    const std::vector<std::pair<std::string, std::string>> lines = {
+        {"fr", "Bonjour les enfants, voulez-vous voir mon spectacle?"},
+        {"es", "Buenos días, amigos, bienvenidos al teatro de marionetas."},
+        {"bg", "Добър ден, деца, елате да гледате представлението."},
+        {"ro", "Bună ziua, copii, veniți să vedeți spectacolul nostru."}};
+    for (const auto& [voice, text] : lines) {
+        const auto s = speak(text, voice);
+        const auto r = alignText(synth(), wav("align_" + voice + ".wav", s.samples, s.rate), text,
+                                 voice, dsp::TemplateSet::loadDefault());
+        EXPECT_FALSE(r.fellBack) << voice;
+        EXPECT_EQ(placed(r), r.alignment.words.size()) << voice;
+        const auto errors = boundaryErrors(r.alignment.schedule, s.labels);
+        ASSERT_GT(errors.size(), 20u) << voice;
+        // Issue 11's goal for espeak-ng speech, median within 15 ms, holds in every language
+        // (measured 6.5-9.5 ms; 90th percentile 30-43 ms).
+        EXPECT_LE(errors[errors.size() / 2], 0.015) << voice;
+        EXPECT_LE(errors[errors.size() * 9 / 10], 0.050) << voice;
+    }
+}
+
 // Voices the templates were not trained on: aligned a second time on templates moved toward the
 // voice's own frames (AlignerConfig::fileAdaptationPriorFrames), the boundaries come closer.
 TEST(AlignText, ASecondPassOnTheVoiceItselfBringsBoundariesCloser) {

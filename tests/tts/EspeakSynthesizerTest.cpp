@@ -100,6 +100,49 @@ TEST(EspeakSynthesizer, AWordAfterADashIsNamedNotTheDash) {
     EXPECT_EQ(ru[2].text, "в");
 }
 
+// The mouth classes of a word in another language, as the aligner sees them (pauses are the
+// gaps' job, not the word's).
+std::vector<std::string> classesOf(const std::string& text, const std::string& voice,
+                                   std::size_t word) {
+    const auto script = scriptForText(synthesizer(), text, voice, espeakMapForVoice(voice), nullptr);
+    std::vector<std::string> out;
+    if (word < script.size())
+        for (const auto& p : script[word].phonemes)
+            if (p.phoneme != "sil") out.push_back(p.phoneme);
+    return out;
+}
+
+// French, Spanish, Bulgarian and Romanian lines are said and aligned through their own maps
+// (config/phonemes/espeak-fr.toml, -es, -bg, -ro): the lips close for m, b and p, meet the teeth for f and v,
+// round for ou and u, and the jaw opens for a, whatever the language's own letters.
+TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
+    EXPECT_EQ(classesOf("Bonjour, ma petite fille.", "fr", 1),
+              (std::vector<std::string>{"bmp", "ah"}));
+    const auto fromage = classesOf("du fromage", "fr", 1);  // f R o m a Z
+    ASSERT_EQ(fromage.size(), 6u);
+    EXPECT_EQ(fromage[0], "f");
+    EXPECT_EQ(fromage[2], "ow");
+    EXPECT_EQ(fromage[3], "bmp");
+    EXPECT_EQ(fromage[4], "aa");
+    EXPECT_EQ(classesOf("vous", "fr", 0), (std::vector<std::string>{"f", "w"}));
+    EXPECT_EQ(classesOf("Buenos días, mamá.", "es", 2),
+              (std::vector<std::string>{"bmp", "aa", "bmp", "aa"}));
+    const auto fruta = classesOf("fruta", "es", 0);  // f r u t a
+    ASSERT_EQ(fruta.size(), 5u);
+    EXPECT_EQ(fruta[0], "f");
+    EXPECT_EQ(fruta[2], "w");
+    EXPECT_EQ(fruta[3], "d");
+    EXPECT_EQ(classesOf("Мама, обичам плодове.", "bg", 0),
+              (std::vector<std::string>{"bmp", "ah", "bmp", "ah"}));
+    const auto plodove = classesOf("плодове", "bg", 0);  // p l o d o v e
+    ASSERT_EQ(plodove.size(), 7u);
+    EXPECT_EQ(plodove[0], "bmp");
+    EXPECT_EQ(plodove[2], "ao");
+    EXPECT_EQ(plodove[5], "f");
+    EXPECT_EQ(classesOf("Mama mănâncă fructe bune.", "ro", 3),
+              (std::vector<std::string>{"bmp", "w", "d", "eh"}));
+}
+
 TEST(EspeakSynthesizer, UnknownVoiceIsAnInputErrorNamingIt) {
     try {
         synthesizer().synthesize({"hello", "xx-nowhere", 0, -1});
