@@ -104,7 +104,8 @@ TEST(EspeakSynthesizer, AWordAfterADashIsNamedNotTheDash) {
 // gaps' job, not the word's).
 std::vector<std::string> classesOf(const std::string& text, const std::string& voice,
                                    std::size_t word) {
-    const auto script = scriptForText(synthesizer(), text, voice, espeakMapForVoice(voice), nullptr);
+    const auto script =
+        scriptForText(synthesizer(), text, voice, espeakMapForVoice(voice), nullptr);
     std::vector<std::string> out;
     if (word < script.size())
         for (const auto& p : script[word].phonemes)
@@ -113,8 +114,8 @@ std::vector<std::string> classesOf(const std::string& text, const std::string& v
 }
 
 // French, Spanish, Bulgarian and Romanian lines are said and aligned through their own maps
-// (config/phonemes/espeak-fr.toml, -es, -bg, -ro): the lips close for m, b and p, meet the teeth for f and v,
-// round for ou and u, and the jaw opens for a, whatever the language's own letters.
+// (config/phonemes/espeak-fr.toml, -es, -bg, -ro): the lips close for m, b and p, meet the teeth
+// for f and v, round for ou and u, and the jaw opens for a, whatever the language's own letters.
 TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
     EXPECT_EQ(classesOf("Bonjour, ma petite fille.", "fr", 1),
               (std::vector<std::string>{"bmp", "ah"}));
