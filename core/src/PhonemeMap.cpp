@@ -24,6 +24,10 @@ std::unordered_map<std::string, std::string> readTable(const TomlTable& doc, con
 }  // namespace
 
 PhonemeMap PhonemeMap::load(const std::filesystem::path& file) {
+    return load(file, 0);
+}
+
+PhonemeMap PhonemeMap::load(const std::filesystem::path& file, int depth) {
     const auto doc = TomlTable::parseFile(file);
     PhonemeMap m;
     m.name_ = doc.optString("name").value_or(file.stem().string());
@@ -37,9 +41,32 @@ PhonemeMap PhonemeMap::load(const std::filesystem::path& file) {
     for (auto& [k, v] : readTable(doc, "map", set)) m.exact_.emplace(m.normalise(k), v);
     for (auto& [k, v] : readTable(doc, "nearest", set)) m.nearest_.emplace(m.normalise(k), v);
     for (auto& s : m.ignored_) s = m.normalise(s);
+    const auto fallback = doc.optString("fallback");
     doc.finish();
     if (m.exact_.empty()) throw InputError(file.string(), 0, "phoneme map has an empty [map]");
+    if (fallback) m.addFallback(file, *fallback, depth);
     return m;
+}
+
+// A language's espeak-ng voice reads some words with another voice (French and Bulgarian switch
+// to English for words they take for English), and their phonemes come under that voice's
+// names: the map names the map those come from. Its entries count where this map has none.
+void PhonemeMap::addFallback(const std::filesystem::path& file, const std::string& name,
+                             int depth) {
+    constexpr int kMaxFallbacks = 4;  // a chain, not a cycle
+    if (depth >= kMaxFallbacks)
+        throw InputError(file.string(), 0,
+                         "fallback '" + name + "': more than " + std::to_string(kMaxFallbacks) +
+                             " maps fall back in a chain (a cycle?)");
+    const auto other = load(findNamedDataFile(name, "phonemes", ".toml"), depth + 1);
+    if (other.phonemeSet_ != phonemeSet_)
+        throw InputError(file.string(), 0,
+                         "fallback '" + name + "' maps onto phoneme set '" + other.phonemeSet_ +
+                             "', not '" + phonemeSet_ + "'");
+    for (const auto& [k, v] : other.exact_) exact_.emplace(normalise(k), v);
+    for (const auto& [k, v] : other.nearest_) nearest_.emplace(normalise(k), v);
+    for (const auto& s : other.ignored_)
+        if (!isIgnored(s)) ignored_.push_back(normalise(s));
 }
 
 PhonemeMap PhonemeMap::named(std::string_view nameOrPath) {

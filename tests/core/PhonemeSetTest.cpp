@@ -51,6 +51,43 @@ TEST(PhonemeMap, RejectsTargetsOutsideTheSetNamingLineAndKey) {
     }
 }
 
+// French espeak-ng reads "camping" or "wapiti" with its English voice: those phonemes come
+// under English names, which the French map takes from espeak-en.toml (its `fallback`), while
+// a name French uses for its own sound keeps the French class ("a" is the open /a/, aa).
+TEST(PhonemeMap, AFallbackMapFillsOnlyTheNamesTheMapLacks) {
+    const auto fr = PhonemeMap::named("espeak-fr");
+    EXPECT_EQ(fr.map("a")->phoneme, "aa");
+    EXPECT_EQ(PhonemeMap::named("espeak-en").map("a")->phoneme, "ah");
+    EXPECT_EQ(fr.map("aI")->phoneme, "ay");  // English only
+    EXPECT_EQ(fr.map("T")->phoneme, "th");
+    EXPECT_TRUE(fr.isIgnored("(en)"));
+    EXPECT_EQ(PhonemeMap::named("espeak-ru").map("oU")->phoneme, "ow");  // a Latin-script word
+}
+
+TEST(PhonemeMap, AFallbackCycleOrAnotherSetIsAnErrorNamingTheFile) {
+    const auto dir = std::filesystem::temp_directory_path();
+    const auto a = dir / "lipsyncd_cycle_a.toml", b = dir / "lipsyncd_cycle_b.toml";
+    std::ofstream(a) << "fallback = \"" << b.string() << "\"\n[map]\naa = \"aa\"\n";
+    std::ofstream(b) << "fallback = \"" << a.string() << "\"\n[map]\nbb = \"bmp\"\n";
+    try {
+        PhonemeMap::load(a);
+        FAIL() << "expected an error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("cycle"), std::string::npos) << e.what();
+    }
+    const auto c = dir / "lipsyncd_other_set.toml";
+    std::ofstream(c) << "phoneme_set = \"mandarin\"\nfallback = \"espeak-en\"\n[map]\n"
+                        "aa = \"aa\"\n";
+    try {
+        PhonemeMap::load(c);
+        FAIL() << "expected an error";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find(c.string()), std::string::npos) << what;
+        EXPECT_NE(what.find("espeak-en"), std::string::npos) << what;
+    }
+}
+
 TEST(PhonemeMap, EnglishIpaCoversTheFortyPhonemesLikeArpabet) {
     const auto ipa = PhonemeMap::named("ipa");
     const auto arpabet = PhonemeMap::named("arpabet");

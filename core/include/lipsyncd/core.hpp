@@ -93,6 +93,7 @@ class PhonemeMap {
         std::string phoneme;  // a class name of the set
         bool approximate;     // from the map's [nearest] table: the caller should warn
     };
+    // `fallback = "NAME"`: symbols this map lacks are looked up in that map (config/phonemes/).
     static PhonemeMap load(const std::filesystem::path& file);
     // Loads config/phonemes/<name>.toml (or a path).
     static PhonemeMap named(std::string_view nameOrPath);
@@ -106,6 +107,8 @@ class PhonemeMap {
     const std::string& phonemeSet() const { return phonemeSet_; }
 
   private:
+    static PhonemeMap load(const std::filesystem::path& file, int depth);
+    void addFallback(const std::filesystem::path& file, const std::string& name, int depth);
     std::string normalise(std::string_view symbol) const;
     std::string name_;
     std::string phonemeSet_ = "common";
