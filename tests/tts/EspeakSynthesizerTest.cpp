@@ -144,6 +144,16 @@ TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
               (std::vector<std::string>{"bmp", "w", "d", "eh"}));
 }
 
+// French espeak-ng says "tout le monde" as one dictionary entry, one word event whose length
+// covers "tout": the word list named "tout" for all three words' sounds.
+TEST(EspeakSynthesizer, WordsEspeakSaysAsOneAreNamedTogether) {
+    const auto fr = scriptForText(synthesizer(), "Bonjour tout le monde.", "fr",
+                                  espeakMapForVoice("fr"), nullptr);
+    std::vector<std::string> words;
+    for (const auto& w : fr) words.push_back(w.text);
+    EXPECT_EQ(words, (std::vector<std::string>{"Bonjour", "tout le monde"}));
+}
+
 TEST(EspeakSynthesizer, UnknownVoiceIsAnInputErrorNamingIt) {
     try {
         synthesizer().synthesize({"hello", "xx-nowhere", 0, -1});

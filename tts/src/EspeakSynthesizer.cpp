@@ -103,13 +103,14 @@ bool isSound(const std::string& name) {
     return std::isalnum(first) != 0 || first == '@';
 }
 
+bool isWordByte(char c) {
+    const auto b = static_cast<unsigned char>(c);
+    return b >= 0x80 || std::isalnum(b) != 0;  // any byte of a non-ASCII letter counts
+}
+
 // The word at [from, to) of the text. Before a word set off by a dash ("a house - in the town")
 // espeak-ng places the word's event on the dash; the word is the next one in the text.
 std::string wordAt(const std::string& text, std::size_t from, std::size_t to) {
-    const auto isWordByte = [](char c) {
-        const auto b = static_cast<unsigned char>(c);
-        return b >= 0x80 || std::isalnum(b) != 0;  // any byte of a non-ASCII letter counts
-    };
     if (from >= to || std::any_of(text.begin() + from, text.begin() + to, isWordByte))
         return text.substr(from, to - from);
     const auto isSpace = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
@@ -120,14 +121,29 @@ std::string wordAt(const std::string& text, std::size_t from, std::size_t to) {
     return std::string(begin, end);
 }
 
+// The words espeak-ng says as one ("tout le monde" is one entry of its French dictionary, one
+// word event whose length covers "tout"): the word's text runs on to where the next word's event
+// starts, so a name says every word its phonemes are (trailing spaces and marks left off).
+std::string wordNamed(const std::string& text, std::size_t from, std::size_t to,
+                      std::size_t nextFrom) {
+    auto name = wordAt(text, from, to);
+    if (name != text.substr(from, to - from) || nextFrom <= to) return name;  // a dash's word
+    const auto rest = std::string_view(text).substr(to, nextFrom - to);
+    const auto last = std::find_if(rest.rbegin(), rest.rend(), isWordByte);
+    if (last != rest.rend()) name += rest.substr(0, static_cast<std::size_t>(rest.rend() - last));
+    return name;
+}
+
 // Each word event owns the phoneme events from it to the next word event; pauses before the
 // first word belong to none.
 std::vector<SpokenWord> spokenWords(const std::string& text, const Collector& c, double total) {
     std::vector<SpokenWord> words;
     for (std::size_t w = 0; w < c.words.size(); ++w) {
         const auto& mark = c.words[w];
-        SpokenWord word{wordAt(text, byteOffset(text, mark.position - 1),
-                               byteOffset(text, mark.position - 1 + mark.length)),
+        const auto nextFrom =
+            w + 1 < c.words.size() ? byteOffset(text, c.words[w + 1].position - 1) : text.size();
+        SpokenWord word{wordNamed(text, byteOffset(text, mark.position - 1),
+                                  byteOffset(text, mark.position - 1 + mark.length), nextFrom),
                         {}};
         const auto last = w + 1 < c.words.size() ? c.words[w + 1].firstEvent : c.events.size();
         std::size_t shareFrom = 0;  // the segment a run of zero-length phonemes shares
