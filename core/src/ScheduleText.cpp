@@ -153,7 +153,7 @@ PhonemeSchedule readScheduleFile(const std::filesystem::path& file,
 namespace {
 
 // The segments as written: times in whole milliseconds, and a segment that rounds to no length
-// (a sliver at a file's end, e.g. 0.9975 to 0.998 s) left out, so that its neighbours still
+// (a sliver at a file's end, e.g. 0.9978 to 0.998 s) left out, so that its neighbours still
 // touch and every file written reads back (the reader refuses a segment that ends where it
 // starts).
 std::vector<PhonemeSegment> asWritten(std::span<const PhonemeSegment> schedule) {

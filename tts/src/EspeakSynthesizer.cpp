@@ -127,7 +127,10 @@ std::string wordAt(const std::string& text, std::size_t from, std::size_t to) {
 std::string wordNamed(const std::string& text, std::size_t from, std::size_t to,
                       std::size_t nextFrom) {
     auto name = wordAt(text, from, to);
-    if (name != text.substr(from, to - from) || nextFrom <= to) return name;  // a dash's word
+    // On a dash (marks only), wordAt has found the word after it: that is the name.
+    const bool onADash =
+        from < to && std::none_of(text.begin() + from, text.begin() + to, isWordByte);
+    if (onADash || nextFrom <= to) return name;
     const auto rest = std::string_view(text).substr(to, nextFrom - to);
     const auto last = std::find_if(rest.rbegin(), rest.rend(), isWordByte);
     if (last != rest.rend()) name += rest.substr(0, static_cast<std::size_t>(rest.rend() - last));
