@@ -325,12 +325,9 @@ def main():
                 if args.subset and made >= args.subset:
                     break
                 wav, lab = folder / f"{name}.wav", folder / f"{name}.lab"
-                if wav.exists() and (lab.exists() or words == BY_ALIGNER):
-                    write_text(folder / f"{name}.txt", text)
-                    made += 1
-                    continue
-                if words == BY_ALIGNER:
+                if words == BY_ALIGNER and not wav.exists():
                     convert(audio, wav)
+                if wav.exists() and (lab.exists() or words == BY_ALIGNER):
                     write_text(folder / f"{name}.txt", text)
                     made += 1
                     continue
