@@ -55,6 +55,7 @@ TEST(ScheduleText, ASliverThatRoundsToNoLengthIsLeftOutSoTheFileReadsBack) {
     writeScheduleJson(json, in);
     EXPECT_EQ(nlohmann::json::parse(json.str()).size(), 2u);
 }
+
 TEST(ScheduleText, MapsArpabetLabelsAndFillsGapsWithSilence) {
     const auto map = PhonemeMap::named("arpabet");
     ScheduleReadOptions o;
