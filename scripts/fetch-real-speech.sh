@@ -10,7 +10,8 @@
 # ($REAL_SPEECH_CACHE, default build/real-speech-cache): no root needed, nothing installed, and
 # the audio never enters the repository. Labelling needs sox and, for the English word lists,
 # pocketsphinx + pocketsphinx-en-us (a development-time labeller; the product never uses it):
-# `apt-get install sox libsox-fmt-base pocketsphinx pocketsphinx-en-us`.
+# `apt-get install sox libsox-fmt-base pocketsphinx pocketsphinx-en-us` (and libsox-fmt-mp3 for
+# the fotaq source).
 # Exit codes: 0 done, 1 error, 2 usage, 77 the packages or tools cannot be had (tests skip).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -18,7 +19,7 @@ out="${1:?usage: fetch-real-speech.sh OUT_DIR [--subset N] [--split train|dev]}"
 shift
 cache="${REAL_SPEECH_CACHE:-$here/build/real-speech-cache}"
 
-split=""
+split="" mp3=""
 for ((i = 1; i <= $#; i++)); do [ "${!i}" = --split ] && { j=$((i + 1)); split="${!j:-}"; }; done
 
 # The packages behind the speakers asked for (config/corpus/real-speakers.txt: SOURCE column).
@@ -35,6 +36,7 @@ while read -r speaker kind source; do
                packages+=(fillets-ng-data "fillets-ng-data-$lang") ;;
     festvox-ru) packages+=(festvox-ru) ;;
     tuxpaint:*) packages+=(tuxpaint-stamps-default) ;;
+    fotaq) packages+=(flight-of-the-amazon-queen) mp3=1 ;;
     *) echo "fetch-real-speech.sh: $speaker: unknown source '$source'" >&2; exit 1 ;;
   esac
 done <"$here/config/corpus/real-speakers.txt"
@@ -47,6 +49,8 @@ for t in "${tools[@]}"; do
   command -v "$t" >/dev/null ||
     unavailable "$t not found (apt-get install sox libsox-fmt-base pocketsphinx pocketsphinx-en-us)"
 done
+[ -z "$mp3" ] || sox -h 2>/dev/null | grep -q 'FORMATS:.* mp3' ||
+  unavailable "sox cannot read MP3 (apt-get install libsox-fmt-mp3), needed by the fotaq source"
 [ -f /usr/share/pocketsphinx/model/en-us/cmudict-en-us.dict ] ||
   unavailable "the pocketsphinx-en-us model is not installed (apt-get install pocketsphinx-en-us)"
 

@@ -12,7 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev
   libcpp-httplib-dev chromium chromium-driver
-  sox libsox-fmt-base pocketsphinx pocketsphinx-en-us  # labelling real speech (tests, training)
+  sox libsox-fmt-base libsox-fmt-mp3 pocketsphinx pocketsphinx-en-us  # labelling real speech (tests, training)
 )
 
 missing=()

@@ -26,6 +26,9 @@ Labels:
   44.1 kHz), its words in the stamp's NAME.txt (the `LANG.utf8=` line). Written as NAME.wav +
   NAME.txt only, without labels: scripts/train-templates.sh labels them with the project's own
   aligner (`lipsync align --voice LANG`), on templates trained without them.
+- fotaq (flight-of-the-amazon-queen): the game's dialogue, each clip's words from the game's own
+  text (scripts/fotaq_clips.py); written as NAME.wav + NAME.txt and labelled by the project's
+  aligner, as tuxpaint is. Needs sox's MP3 format (libsox-fmt-mp3).
 Items whose words are not in the dictionary, or that the aligner cannot fit, are skipped and
 counted. Reproducible: same packages, same tools, same files.
 """
@@ -174,6 +177,37 @@ def tuxpaint_items(root, lang):
             yield name, audio, BY_ALIGNER, None, text
 
 
+# Flight of the Amazon Queen's dialogue (scripts/fotaq_clips.py): dozens of English actors, as
+# 16 kbps MP3 at 11 kHz. At most FOTAQ_MAX_PER_SPEAKER clips a character (in name order), so
+# that Joe, who says 2,790, does not outweigh everyone else; sounds ("(sigh)", "<koff>"),
+# spelled letters, shouted codes and lines under three words are left out, and so are the
+# cutscene "speakers" that are captions or objects. Labelled later by the project's own aligner
+# (train-templates.sh), like tuxpaint: pocketsphinx's en-us model misreads this audio.
+FOTAQ_MAX_PER_SPEAKER = 40
+FOTAQ_NOT_SPEAKERS = {"caption", "note", "path", "smoke", "telephone", "door", "torch", "rock",
+                      "lily_pad"}
+
+
+def fotaq_items(root):
+    sys.path.insert(0, str(HERE / "scripts"))
+    import fotaq_clips
+    game = fotaq_clips.Queen(root / "usr/share/scummvm/flight-of-the-amazon-queen/queen.1c")
+    clips_dir = root / "fotaq-clips"  # each clip as an MP3 file, for sox
+    clips_dir.mkdir(exist_ok=True)
+    per_speaker = {}
+    for clip in game.all_clips():  # in name order
+        speaker, text = clip["speaker"], clip["text"]
+        if speaker in FOTAQ_NOT_SPEAKERS or per_speaker.get(speaker, 0) >= FOTAQ_MAX_PER_SPEAKER:
+            continue
+        if re.search(r"[()<>\[\]]", text) or not re.search(r"[a-z]{2}", text) or len(text.split()) < 3:
+            continue
+        per_speaker[speaker] = per_speaker.get(speaker, 0) + 1
+        audio = clips_dir / f"{clip['name']}.mp3"
+        if not audio.exists():
+            audio.write_bytes(game.data[clip["offset"]:clip["offset"] + clip["size"]])
+        yield clip["name"], audio, BY_ALIGNER, None, text
+
+
 def items_of(root, source):
     kind, *args = source.split(":")
     if kind == "asterisk":
@@ -188,6 +222,8 @@ def items_of(root, source):
         return festvox_ru_items(root)
     if kind == "tuxpaint":
         return tuxpaint_items(root, *args)
+    if kind == "fotaq":
+        return fotaq_items(root)
     sys.exit(f"config/corpus/real-speakers.txt: unknown source '{source}'")
 
 
@@ -294,7 +330,8 @@ def convert(src, dst):
     # -R: sox dithers with a fixed seed, so the same package gives the same WAV (and the same
     # labels) on every run; without it the dither differs, and pocketsphinx places a few
     # marginal files on one run and not on the next.
-    subprocess.run(["sox", "-R", "-q", str(src), "-r", "16000", "-c", "1", "-b", "16", str(dst)],
+    # -V1: no warnings (fotaq's MP3 decodes a sample or two past full scale, which sox clips).
+    subprocess.run(["sox", "-R", "-q", "-V1", str(src), "-r", "16000", "-c", "1", "-b", "16", str(dst)],
                    check=True)
     info = subprocess.run(["soxi", "-D", str(dst)], capture_output=True, text=True, check=True)
     return float(info.stdout)
