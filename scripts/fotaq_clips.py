@@ -134,9 +134,12 @@ class Queen:
     def __init__(self, path):
         with open(path, "rb") as f:
             self.data = f.read()
-        self.ents = read_table(self.data)
-        self.clipnames = {n[:-3]: v for n, v in self.ents.items() if n.endswith(".SB")}
-        self._read_jas()
+        try:
+            self.ents = read_table(self.data)
+            self.clipnames = {n[:-3]: v for n, v in self.ents.items() if n.endswith(".SB")}
+            self._read_jas()
+        except (struct.error, KeyError) as e:  # a cut-off file or one without the game's text
+            raise ValueError(f"truncated or incomplete bundle ({e})") from e
 
     def res(self, name, skip=0):
         off, size = self.ents[name.upper()]
@@ -371,9 +374,14 @@ def category(name):
 
 def main(argv):
     if len(argv) < 2:
-        print("usage: fotaq.py QUEEN1C > clips.tsv", file=sys.stderr)
+        print("usage: fotaq_clips.py QUEEN1C > clips.tsv", file=sys.stderr)
         return 2
-    q = Queen(argv[1])
+    try:
+        q = Queen(argv[1])
+    except (OSError, ValueError) as e:
+        print(f"fotaq_clips.py: {argv[1]}: not Flight of the Amazon Queen's queen.1c ({e})",
+              file=sys.stderr)
+        return 1
     res = q.all_clips()
     for c in res:
         print("%s\t%s\t%s" % (c["name"], c["speaker"], c["text"].replace("\t", " ")))

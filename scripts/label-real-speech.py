@@ -191,7 +191,11 @@ FOTAQ_NOT_SPEAKERS = {"caption", "note", "path", "smoke", "telephone", "door", "
 def fotaq_items(root):
     sys.path.insert(0, str(HERE / "scripts"))
     import fotaq_clips
-    game = fotaq_clips.Queen(root / "usr/share/scummvm/flight-of-the-amazon-queen/queen.1c")
+    bundle = root / "usr/share/scummvm/flight-of-the-amazon-queen/queen.1c"
+    try:
+        game = fotaq_clips.Queen(bundle)
+    except (OSError, ValueError) as e:
+        sys.exit(f"{bundle}: cannot read the game's clips ({e})")
     clips_dir = root / "fotaq-clips"  # each clip as an MP3 file, for sox
     clips_dir.mkdir(exist_ok=True)
     per_speaker = {}

@@ -3,6 +3,7 @@
 resource table, how a line is cut into clips, the text left after the control codes)."""
 import struct
 import sys
+import tempfile
 import unittest
 from pathlib import Path
 
@@ -33,6 +34,13 @@ class ResourceTable(unittest.TestCase):
     def test_a_file_that_is_not_a_bundle_is_refused(self):
         with self.assertRaises(ValueError):
             fotaq_clips.read_table(b"RIFF" + bytes(40))
+
+    def test_a_bundle_without_the_games_text_is_refused_by_name(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "queen.1c"
+            path.write_bytes(bundle([("020006J1.SB", b"mp3 one")]))
+            with self.assertRaisesRegex(ValueError, "QUEEN.JAS"):
+                fotaq_clips.Queen(path)
 
 
 class LinesIntoClips(unittest.TestCase):
