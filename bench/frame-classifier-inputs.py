@@ -135,8 +135,6 @@ def slopes(x, files, reach=2):
 
 def variant_inputs(d, variant):
     x, f = d["lpc"], d["lpc_file"]
-    if variant == "the 34 features":
-        return x
     if variant == "and their slopes (±2 frames)":
         return np.concatenate([x, slopes(x, f)], axis=1)
     if variant == "and their slopes and curvature":
@@ -244,18 +242,18 @@ def main():
         print(f"{label:45s}" + " / ".join(f"{a:.1f} %" for a in figures), flush=True)
         return net
 
-    for variant in ["the 34 features", "and their slopes (±2 frames)",
-                    "and their slopes and curvature", "five frames, ±20 ms",
-                    "five frames, ±40 ms", "three frames, the last 40 ms"]:
+    base = row("the 34 features", lambda d: d["lpc"])
+    for variant in ["and their slopes (±2 frames)", "and their slopes and curvature",
+                    "five frames, ±20 ms", "five frames, ±40 ms", "three frames, the last 40 ms"]:
         row(variant, lambda d, v=variant: variant_inputs(d, v))
     print("speech frames only:")
-    net = row("  the 34 LPC features", lambda d: d["lpc"], speech_only=True, gate=False)
+    row("  the 34 LPC features", lambda d: d["lpc"], speech_only=True, gate=False)
     row("  24 log mel bands to 5 kHz and the level", lambda d: d["mel"], speech_only=True,
         gate=False, kind="mel")
     row("  the same, the file's mean bands removed", mean_removed, speech_only=True, gate=False,
         kind="mel")
-    print("vocal-tract-length warp, best factor per speaker (an upper bound: chosen on the labels):")
-    base = row("  the 34 features", lambda d: d["lpc"])
+    print("vocal-tract-length warp of the 34 features' network, best factor per speaker (an upper "
+          "bound: chosen on the labels):")
     for f in scored:
         d = data[f]
         best = max((group_accuracy(base, warp(d["lpc"], a), d["lpc_y"], d["gate"]), a)

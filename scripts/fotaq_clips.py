@@ -90,7 +90,7 @@ def get_string(buf, off, align=2):
 # --------------------------------------------------------------------------
 # sentence splitting (mirrors how the engine cuts a line into voice pieces)
 def split_segments(sentence):
-    """Yield (segment_index, text, command) for a spoken sentence."""
+    """(piece index, text) for each spoken piece of a line."""
     out = []
     seg_idx = 0
     seg_start = 0
@@ -101,18 +101,17 @@ def split_segments(sentence):
             text = sentence[seg_start:i]
             i += 1
             code = sentence[i:i + 2]
-            cmd = code
             if code == "XY":
                 i += 11
             i += 2
             if code not in ("GD", "GM"):     # these are not spoken
-                out.append((seg_idx, text, cmd))
+                out.append((seg_idx, text))
             seg_idx += 1
             seg_start = i
         else:
             i += 1
     if seg_start < n:
-        out.append((seg_idx, sentence[seg_start:], None))
+        out.append((seg_idx, sentence[seg_start:]))
     return out
 
 
@@ -157,12 +156,10 @@ class Queen:
             p += 16
         txt = self.res("QUEEN2.JAS").decode("latin-1")
         lines = txt.split("\r\n")
-        self.jas_lines = lines
-        o = 0
-        self.descriptions = lines[o:o + self.num_desc]; o += self.num_desc
-        self.names = lines[o:o + self.num_names]; o += self.num_names
-        self.rooms = lines[o:o + self.num_rooms]; o += self.num_rooms
-        self.verbs = lines[o:o + 12]; o += 12
+        # Descriptions, object names, room names, 12 verbs, then Joe's stock responses.
+        self.descriptions = lines[:self.num_desc]
+        self.names = lines[self.num_desc:self.num_desc + self.num_names]
+        o = self.num_desc + self.num_names + self.num_rooms + 12
         self.joe_responses = lines[o:o + JOE_RESPONSE_MAX]
 
     def object_name(self, objnum):
@@ -173,41 +170,35 @@ class Queen:
         return None
 
     # ---------------- emit helpers
-    def _emit(self, out, prefix, sentence, speaker, source, whole=False):
-        prefix = prefix.replace(" ", "0").upper()
-        if whole:
-            segs = [(0, sentence, None)]
-        else:
-            segs = split_segments(sentence)
-        for idx, text, _cmd in segs:
+    def _emit(self, out, prefix, sentence, speaker, whole=False):
+        prefix = prefix.replace(" ", "0")
+        segs = [(0, sentence)] if whole else split_segments(sentence)
+        for idx, text in segs:
             if idx > 15:
                 continue
-            name = prefix + "%x" % (idx + 1)
-            name = name.upper()
+            name = (prefix + "%x" % (idx + 1)).upper()
             t = clean(text)
             if not speakable(t):
                 continue
             if name not in self.clipnames:
                 continue
-            out.setdefault(name, (t, speaker, source, sentence))
+            out.setdefault(name, (t, speaker))
 
     # ---------------- JOE descriptions
     def joe_clips(self, out):
         for i, s in enumerate(self.joe_responses, 1):
-            self._emit(out, "JOE%04d" % i, s, "joe", "JAS:response%d" % i)
+            self._emit(out, "JOE%04d" % i, s, "joe")
         for i, s in enumerate(self.descriptions, 1):
             if s.upper().endswith(".CUT"):
                 continue
-            self._emit(out, "JOE%04d" % (i + JOE_RESPONSE_MAX), s, "joe",
-                       "JAS:desc%d" % i)
+            self._emit(out, "JOE%04d" % (i + JOE_RESPONSE_MAX), s, "joe")
 
     # ---------------- DOG dialogues
     def parse_dog(self, name):
         b = self.res(name, DOG_HEADER)
         level_max = abs(_s16(b, 0))
-        unique_key, talk_key, jmax, pmax = struct.unpack_from(">hhhh", b, 2)
+        talk_key, jmax, pmax = struct.unpack_from(">hhh", b, 4)
         p1 = _u16(b, 22)
-        cut = _u16(b, 24)
         p2 = _u16(b, 26)
         joe_off = 32 + level_max * 96
 
@@ -240,28 +231,26 @@ class Queen:
                     pre = "%2dSSSSJ" % key
                 else:
                     pre = "%2d%4xJ" % (key, ident & 0xFFFF)
-                self._emit(out, pre, s, "joe", "DOG:%s:J%d" % (name, ident))
+                self._emit(out, pre, s, "joe")
             for ident, s in per:
                 pre = "%2d%4xP" % (key, ident & 0xFFFF)
-                self._emit(out, pre, s, stem, "DOG:%s:P%d" % (name, ident))
+                self._emit(out, pre, s, stem)
             if person2:
-                self._emit(out, "%2dXXXXP" % key, person2, stem, "DOG:%s:P2" % name)
+                self._emit(out, "%2dXXXXP" % key, person2, stem)
             if joe2:
-                self._emit(out, "%2dXXXXJ" % key, joe2, "joe", "DOG:%s:J2" % name)
+                self._emit(out, "%2dXXXXJ" % key, joe2, "joe")
 
     # ---------------- CUT cutscenes
     def parse_cut(self, name):
         b = self.res(name, CUT_HEADER)
         count = abs(_s16(b, 2))
         next_sentence = _u16(b, 8)
-        off = next_sentence
-        entry, off = get_string(b, off, 2)
+        _, off = get_string(b, next_sentence, 2)  # the cutscene's entry point, not spoken
         sentences = []
         for _ in range(count):
             s, off = get_string(b, off, 2)
             sentences.append(s)
-        objs = self._walk_cut_objects(b, count)
-        return count, sentences, objs
+        return sentences, self._walk_cut_objects(b, count)
 
     def _walk_cut_objects(self, b, count):
         """Return list of (objectNumber) per cutaway object, or None when the
@@ -306,12 +295,12 @@ class Queen:
             return None
         return objs
 
-    def cut_clips(self, out, stats=None):
+    def cut_clips(self, out):
         for name in sorted(n for n in self.ents if n.endswith(".CUT")):
             base = name[:-4]
             pad = base + "_" * max(0, 5 - len(base))
             try:
-                count, sentences, objs = self.parse_cut(name)
+                sentences, objs = self.parse_cut(name)
             except (struct.error, IndexError):
                 continue
             for i, s in enumerate(sentences, 1):
@@ -334,10 +323,7 @@ class Queen:
                             speaker = SPEAKER_ALIAS.get(speaker, speaker)
                     else:
                         continue        # not spoken in this cutaway
-                if stats is not None:
-                    stats["cut_objs_ok" if objs is not None else "cut_objs_bad"] = \
-                        stats.get("cut_objs_ok" if objs is not None else "cut_objs_bad", 0) + 1
-                self._emit(out, pre, s, speaker, "CUT:%s:%d" % (name, i), whole=whole)
+                self._emit(out, pre, s, speaker, whole=whole)
 
     def all_clips(self):
         out = {}
@@ -346,15 +332,11 @@ class Queen:
         self.cut_clips(out)
         res = []
         for name in sorted(out):
-            text, speaker, source, _full = out[name]
+            text, speaker = out[name]
             off, size = self.clipnames[name]
             res.append({"name": name, "offset": off, "size": size, "text": text,
-                        "speaker": speaker, "source": source})
+                        "speaker": speaker})
         return res
-
-
-def clips(queen1c_path):
-    return Queen(queen1c_path).all_clips()
 
 
 def category(name):

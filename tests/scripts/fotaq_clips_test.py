@@ -46,12 +46,12 @@ class ResourceTable(unittest.TestCase):
 class LinesIntoClips(unittest.TestCase):
     def test_every_control_code_ends_a_clip_and_positions_count_from_zero(self):
         pieces = fotaq_clips.split_segments("Hello there.*00How are you?*XY00(128,112)*FLBye")
-        self.assertEqual([(i, t) for i, t, _ in pieces],
+        self.assertEqual(pieces,
                          [(0, "Hello there."), (1, "How are you?"), (2, ""), (3, "Bye")])
 
     def test_a_piece_that_is_not_spoken_still_takes_its_number(self):
         # "*GD" / "*GM" pieces have no clip, but the next piece is still clip 2 (index 1).
-        self.assertEqual([(i, t) for i, t, _ in fotaq_clips.split_segments("One*GDTwo*02")],
+        self.assertEqual(fotaq_clips.split_segments("One*GDTwo*02"),
                          [(1, "Two")])
 
     def test_the_text_keeps_only_the_words(self):
