@@ -84,7 +84,9 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"minVowelSeconds", &dsp::AlignerConfig::minVowelSeconds},
         {"minPauseSeconds", &dsp::AlignerConfig::minPauseSeconds},
         {"minConsonantSeconds", &dsp::AlignerConfig::minConsonantSeconds},
-        {"minFractionOfExpected", &dsp::AlignerConfig::minFractionOfExpected}};
+        {"minFractionOfExpected", &dsp::AlignerConfig::minFractionOfExpected},
+        {"tailFractionOfExpected", &dsp::AlignerConfig::tailFractionOfExpected},
+        {"minimumMaxTimeScale", &dsp::AlignerConfig::minimumMaxTimeScale}};
     if (floats.count(name))
         c.*floats.at(name) = static_cast<float>(v);
     else if (doubles.count(name))

@@ -153,11 +153,13 @@ class GraphBuilder {
             if (expected) graph_.expectedSeconds += expectedFrames * hop_;
             const double classMin =
                 (set_[*idx].vowel ? config_.minVowelSeconds : config_.minConsonantSeconds) / hop_;
-            const int chain =
-                std::max(1, static_cast<int>(std::lround(std::max(
-                                classMin, config_.minFractionOfExpected * expectedFrames))));
+            const double minimumScale = std::min(scale_, config_.minimumMaxTimeScale);
+            const double minimumFrames = std::max(hop_, seg.duration() * minimumScale) / hop_;
+            const int chain = std::max(1, static_cast<int>(std::lround(std::max(
+                                              classMin, config_.minFractionOfExpected * minimumFrames))));
             frames += chain;
-            const double stay = std::clamp(1.0 - 1.0 / std::max(1.0, expectedFrames - chain + 1),
+            const double tailFrom = std::max(1.0, config_.tailFractionOfExpected * expectedFrames);
+            const double stay = std::clamp(1.0 - 1.0 / std::max(1.0, expectedFrames - tailFrom + 1),
                                            kMinStay, kMaxStay);
             for (int k = 0; k < chain; ++k) {
                 AlignmentNode node;

@@ -1,8 +1,9 @@
 // The state graph of a forced alignment: a start node; then, for every gap between words (and
 // before the first and after the last), an optional pause and an optional filler (after the
 // last word two fillers: one straight after it, one only after a pause heard); and for every
-// phoneme of every word a chain of minimum-duration nodes, the last with a self-loop whose
-// probability gives the expected duration (a geometric tail; Rabiner 1989, section IV.D). A word
+// phoneme of every word a chain of minimum-duration nodes, the last with a self-loop (a geometric
+// tail; Rabiner 1989, section IV.D) whose mean is what the expected duration leaves after
+// tailFractionOfExpected of it (AlignerConfig: the minimum itself is longer). A word
 // said more than one way (reductions) has one such run of chains per pronunciation, in parallel.
 // Nodes are in time order: every edge goes forward, so the Viterbi pass is one sweep.
 #pragma once

@@ -143,7 +143,11 @@ TEST(AlignText, ASecondPassOnTheVoiceItselfBringsBoundariesCloser) {
         onePass += meanError(0);
         twoPasses += meanError(dsp::AlignerConfig{}.fileAdaptationPriorFrames);
     }
-    EXPECT_LT(twoPasses, onePass * 0.95)
+    // Measured 14.8 → 14.3 ms (mean boundary error). Since the minimum durations grew
+    // (AlignerConfig::minFractionOfExpected) the first pass comes closer on its own, and the
+    // second's gain on these lines fell from 5 % to 3 %; on the espeak-ng dev corpus it still
+    // takes p95 from 37.5 to 35.5 ms (bench/align_accuracy).
+    EXPECT_LT(twoPasses, onePass * 0.98)
         << "one pass " << onePass / 3 << " s, two " << twoPasses / 3;
 }
 

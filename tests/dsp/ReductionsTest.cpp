@@ -82,6 +82,23 @@ TEST(Reductions, WeakFormsAndRulesGiveAlternatives) {
     EXPECT_TRUE(plain[1].alternatives.empty());
 }
 
+// Russian clitics said unstressed: espeak-ng reads "Со" as a stressed /so/; its weak form /sɐ/
+// is offered whatever the case and the quotes around the written word.
+TEST(Reductions, RussianCliticsGetTheirWeakFormsWrittenAnyWay) {
+    const auto map = espeakMapForVoice("ru");
+    const auto reductions = Reductions::forVoice("ru", map);
+    const auto script =
+        scriptForText(synth(), "«Со спокойным» к нему", "ru", map, nullptr, &reductions);
+    ASSERT_EQ(script.size(), 4u);
+    EXPECT_EQ(classes(script[0].phonemes), "z ao");
+    ASSERT_EQ(script[0].alternatives.size(), 1u);
+    EXPECT_EQ(classes(script[0].alternatives[0]), "z ah");
+    // "к", read alone as its letter's name /ka/, is said as /k/ only.
+    ASSERT_EQ(script[2].alternatives.size(), 1u);
+    EXPECT_EQ(classes(script[2].alternatives[0]), "kg");
+    EXPECT_TRUE(script[1].alternatives.empty());
+}
+
 // espeak-ng's speech of `text` with some of its sounds cut out (word index, mnemonic), and
 // its labels with the same sounds cut: a speaker who reduces.
 struct Reduced {

@@ -6,6 +6,8 @@
 #include <lipsyncd/tts.hpp>
 #include <sstream>
 
+#include "Utf8.hpp"
+
 namespace lipsyncd {
 
 namespace {
@@ -19,11 +21,19 @@ std::vector<std::string> splitPhonemes(const std::string& s) {
     return out;
 }
 
-// "And," → "and": the written word as the [words] table keys it.
+// Letters are kept; ASCII and Latin-1 punctuation (« » among it) and general punctuation
+// (“ ” — …: U+2000..U+206F) are not.
+bool isLetter(char32_t c) {
+    if (c < 0x80) return std::isalpha(static_cast<int>(c)) || c == U'\'';
+    if (c < 0xC0) return false;
+    return c != 0xD7 && c != 0xF7 && !(c >= 0x2000 && c <= 0x206F);
+}
+
+// "And," → "and", "«Со" → "со": the written word as the [words] table keys it.
 std::string keyOf(const std::string& written) {
     std::string key;
-    for (const unsigned char c : written)
-        if (std::isalpha(c) || c == '\'' || c >= 0x80) key += static_cast<char>(std::tolower(c));
+    for (const char32_t c : utf8::codePoints(written))
+        if (isLetter(c)) utf8::append(key, utf8::lowerCase(c));
     return key;
 }
 

@@ -6,6 +6,8 @@
 #include <lipsyncd/tts.hpp>
 #include <string_view>
 
+#include "Utf8.hpp"
+
 namespace lipsyncd {
 
 namespace {
@@ -21,22 +23,6 @@ std::string languageOf(const std::string& voice) {
     return base.substr(0, base.find('-'));
 }
 
-// Code points of UTF-8 text (invalid bytes count as one code point each).
-std::vector<char32_t> codePoints(std::string_view s) {
-    std::vector<char32_t> out;
-    for (std::size_t i = 0; i < s.size();) {
-        const auto b = static_cast<unsigned char>(s[i]);
-        const int extra = b >= 0xF0 ? 3 : b >= 0xE0 ? 2 : b >= 0xC0 ? 1 : 0;
-        char32_t c = extra ? b & (0x3F >> extra) : b;
-        std::size_t k = 1;
-        for (; k <= static_cast<std::size_t>(extra) && i + k < s.size(); ++k)
-            c = (c << 6) | (static_cast<unsigned char>(s[i + k]) & 0x3F);
-        out.push_back(c);
-        i += k;
-    }
-    return out;
-}
-
 // A letter outside Latin (Basic Latin to Latin Extended-B, and Latin Extended Additional);
 // general punctuation and symbols (U+2000..U+2BFF) are not letters.
 bool foreignToLatin(char32_t c) {
@@ -47,7 +33,7 @@ bool readable(const std::string& word, const std::string& language) {
     if (std::find(kLatinScriptLanguages.begin(), kLatinScriptLanguages.end(), language) ==
         kLatinScriptLanguages.end())
         return true;  // no rule for this language: trust espeak-ng
-    const auto cps = codePoints(word);
+    const auto cps = utf8::codePoints(word);
     return std::none_of(cps.begin(), cps.end(), foreignToLatin);
 }
 

@@ -774,9 +774,26 @@ struct AlignerConfig {
     // Minimum durations: the segmenter's, and a fraction of the expected duration. Tuned on the
     // espeak-ng training corpus (bench/align_accuracy): fraction 0.3/0.4/0.5 gave boundary
     // p95 48.5/48.5/46.5 ms; a minimum pause of 80 ms (not 1 frame) cut missed boundaries by a
-    // quarter (closures of stops at word boundaries had been taken for pauses).
+    // quarter (closures of stops at word boundaries had been taken for pauses). Retuned with the
+    // real training speakers each left out of its templates (`lipsync eval --align`, visual
+    // groups, klettres-en-gb / asterisk-en-allison) and the espeak-ng training corpus (p95,
+    // share within 20 ms): 0.5 gave 89.3 / 55.7 %, 42.5 ms, 82.4 %; 0.6 89.3 / 56.4 %, 42.5 ms;
+    // 0.7 88.8 / 56.7 %, 41.5 ms, 84.4 %; 0.8 88.2 / 55.3 %, 39.5 ms. Real voices squeezed a
+    // phoneme that fits their templates poorly to its minimum and gave its frames to the
+    // neighbours (festvox-ru's /l/ came out at half its length, its /r/ at twice).
     double minVowelSeconds = 0.03, minConsonantSeconds = 0.02;
-    double minFractionOfExpected = 0.5;
+    double minFractionOfExpected = 0.7;
+    // The tail after the minimum (its stay probability) is set as if the minimum were this
+    // fraction: the longer minimum alone made each further frame dearer, and a last phoneme held
+    // long went to the filler after the line (with 0.5 here: 89.0 / 56.6 %, 40.5 ms, 84.8 %).
+    double tailFractionOfExpected = 0.5;
+    // The minimum follows the measured speaking rate (timeScale) up to this much slower than
+    // espeak-ng's reading. The rate comes from the span of loud frames, and music or noise around
+    // the line lengthens it: then minimum durations no longer fit the words into the speech, and
+    // the words spill into the music. Read speech at its slowest (about 130 words a minute against
+    // espeak-ng's 175) is 1.35 times slower; 1.0 lost 0.9 points within 20 ms on the training
+    // corpus, 1.3 nothing.
+    double minimumMaxTimeScale = 1.3;
     // A stretch no word explains (a cough, music, an added word): cost per frame.
     float fillerCostPerFrame = 1.5f;
     // After the last word: music, applause or the next sound of the show often follow a line,
