@@ -155,8 +155,9 @@ class GraphBuilder {
                 (set_[*idx].vowel ? config_.minVowelSeconds : config_.minConsonantSeconds) / hop_;
             const double minimumScale = std::min(scale_, config_.minimumMaxTimeScale);
             const double minimumFrames = std::max(hop_, seg.duration() * minimumScale) / hop_;
-            const int chain = std::max(1, static_cast<int>(std::lround(std::max(
-                                              classMin, config_.minFractionOfExpected * minimumFrames))));
+            const int chain =
+                std::max(1, static_cast<int>(std::lround(std::max(
+                                classMin, config_.minFractionOfExpected * minimumFrames))));
             frames += chain;
             const double tailFrom = std::max(1.0, config_.tailFractionOfExpected * expectedFrames);
             const double stay = std::clamp(1.0 - 1.0 / std::max(1.0, expectedFrames - tailFrom + 1),
