@@ -149,12 +149,15 @@ class GraphBuilder {
                 throw InputError("word '" + text + "': phoneme '" + seg.phoneme +
                                  "' is not in the phoneme set");
             if (*idx == set_.silence()) continue;  // pauses are the gaps' job
-            const double expectedFrames = std::max(hop_, seg.duration() * scale_) / hop_;
+            // The phoneme's duration in frames at a speaking rate (at least one frame).
+            const auto framesAt = [&](double scale) {
+                return std::max(hop_, seg.duration() * scale) / hop_;
+            };
+            const double expectedFrames = framesAt(scale_);
             if (expected) graph_.expectedSeconds += expectedFrames * hop_;
             const double classMin =
                 (set_[*idx].vowel ? config_.minVowelSeconds : config_.minConsonantSeconds) / hop_;
-            const double minimumScale = std::min(scale_, config_.minimumMaxTimeScale);
-            const double minimumFrames = std::max(hop_, seg.duration() * minimumScale) / hop_;
+            const double minimumFrames = framesAt(std::min(scale_, config_.minimumMaxTimeScale));
             const int chain =
                 std::max(1, static_cast<int>(std::lround(std::max(
                                 classMin, config_.minFractionOfExpected * minimumFrames))));
