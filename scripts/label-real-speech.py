@@ -13,6 +13,8 @@ Labels:
   tool only (the product never depends on it). Each ARPAbet phone is a "word" of a JSGF grammar
   that spells the transcript (every dictionary pronunciation allowed, optional pauses), so the
   decoder's word times are phone times. Phones map to the common set by config/phonemes/arpabet.toml.
+  The words' outer edges are then moved in over room tone (trim_to_voice, below). The British
+  klettres speaker's letters are spelled from espeak-ng's en-gb reading ("zed"), as below.
 - words known in Italian or Spanish (asterisk prompts): the same aligner, each word spelled in
   the nearest English phones from espeak-ng's phonemisation (config/corpus/espeak-arpabet.toml).
 - fillets-ng (Czech, Dutch): the game's dialogue clips, whose words are in its scripts
@@ -33,13 +35,16 @@ Items whose words are not in the dictionary, or that the aligner cannot fit, are
 counted. Reproducible: same packages, same tools, same files.
 """
 import argparse
+import array
 import gzip
+import math
 import os
 import re
 import subprocess
 import sys
 import tempfile
 import tomllib
+import wave
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent.parent
@@ -99,7 +104,11 @@ def klettres_items(root, lang):
     base = root / "usr/share/klettres" / lang
     for sub in ("alpha", "syllab"):
         for audio in sorted((base / sub).glob("*.ogg")):
-            yield f"{sub}_{audio.stem}", audio, [audio.stem.lower()], None, audio.stem.lower()
+            word = audio.stem.lower()
+            # The British speaker says the letters as British English does ("zed", "ar"), which
+            # the American dictionary does not have: spelled from espeak-ng's en-gb reading.
+            words = ("espeak", "en-gb", word) if lang == "en_GB" else [word]
+            yield f"{sub}_{audio.stem}", audio, words, None, word
 
 
 def ktuberling_items(root, lang):
@@ -304,8 +313,78 @@ def align(wav, spelled, work, phones):
     return segments
 
 
+# --- the room before and after the words --------------------------------------------------------
+# pocketsphinx's silence model does not fit every room: on the ktuberling words it ran the last
+# phone a median 60 ms (a tenth of the words, 170 ms or more) into room tone after the voice had
+# stopped, and began the first 40 ms early ("ball": /l/ to 0.75 s, the voice gone at 0.63 s and
+# the room hum alone after it). So the outer edges of the words are moved in over frames that are
+# plainly room tone: within ROOM_DB of the recording's quietest frames (its room) and without the
+# zero crossings of a fricative. Only edges move, only inwards, and a phone left with no sound
+# becomes silence; pauses between words stay the aligner's (an endpoint detector in the manner of
+# Rabiner & Sambur 1975, with the room measured on the file's quietest frames).
+ROOM_DB = 10.0          # dB above the quietest frames that still count as room
+ROOM_FRAMES = 10        # the quietest frames that measure the room
+FRICATIVE_ZCR = 0.25    # zero crossings a sample above which a frame may be a fricative
+
+
+def frame_levels(wav):
+    """Per 10 ms frame of a 16-bit mono WAV: (level in dB, zero crossings a sample)."""
+    with wave.open(str(wav)) as w:
+        rate, data = w.getframerate(), array.array("h", w.readframes(w.getnframes()))
+    if sys.byteorder == "big":
+        data.byteswap()
+    hop, levels = rate // 100, []
+    for start in range(0, len(data) - hop + 1, hop):
+        # about the frame's own mean: a few recordings (ktuberling's tv_*) carry a DC offset
+        mean = sum(data[start:start + hop]) / hop
+        frame = [v - mean for v in data[start:start + hop]]
+        power = sum(v * v for v in frame) / hop
+        crossings = sum((a < 0) != (b < 0) for a, b in zip(frame, frame[1:]))
+        levels.append((10 * math.log10(power + 1e-3), crossings / hop))
+    return levels
+
+
+def trim_to_voice(segments, wav):
+    """segments with the words' outer edges moved in over room tone (see above)."""
+    levels = frame_levels(wav)
+    if len(levels) < 2 * ROOM_FRAMES:
+        return segments
+    quietest = sorted(db for db, _ in levels)[:ROOM_FRAMES]
+    ceiling = sum(quietest) / len(quietest) + ROOM_DB
+
+    def room(i):
+        return levels[i][0] < ceiling and levels[i][1] < FRICATIVE_ZCR
+
+    spoken = [i for i, s in enumerate(segments) if s[2] != "sil"]
+    if not spoken:
+        return segments
+    first, last = segments[spoken[0]][0], segments[spoken[-1]][1]
+    begin = min(int(round(first * 100)), len(levels))
+    while begin < len(levels) and room(begin):
+        begin += 1
+    end = min(int(round(last * 100)), len(levels))
+    while end > begin and room(end - 1):
+        end -= 1
+    voice_start, voice_end = max(first, begin / 100), min(last, end / 100)
+    trimmed = []
+    for start, stop, name in segments:
+        if name != "sil":
+            inner = (max(start, voice_start), min(stop, voice_end))
+            if inner[1] - inner[0] < 0.01:
+                name = "sil"
+            elif inner != (start, stop):
+                trimmed += [(start, inner[0], "sil"), (inner[0], inner[1], name),
+                            (inner[1], stop, "sil")]
+                continue
+        trimmed.append((start, stop, name))
+    return [s for s in trimmed if s[1] > s[0]]
+
+
 def write_lab(path, segments, duration):
     merged = []
+    # to the millisecond first, as written: a sliver shorter than that would read as a segment
+    # that ends before it starts
+    segments = [(round(a, 3), round(b, 3), name) for a, b, name in segments if round(b, 3) > round(a, 3)]
     for start, end, name in segments:
         if merged and merged[-1][2] == name and abs(merged[-1][1] - start) < 0.015:
             merged[-1] = (merged[-1][0], end, name)
@@ -381,7 +460,7 @@ def main():
                         continue
                 duration = convert(audio, wav)
                 if segments is None:
-                    segments = align(wav, spelled, work, phones)
+                    segments = trim_to_voice(align(wav, spelled, work, phones), wav)
                     if not any(s[2] != "sil" for s in segments):
                         wav.unlink()
                         skipped += 1
