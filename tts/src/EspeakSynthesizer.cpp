@@ -201,8 +201,8 @@ SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request)
     if (!selectVoice(request.voice))
         throw InputError("espeak-ng: unknown voice '" + request.voice +
                          "' (list them with: espeak-ng --voices)");
-    if (request.wordsPerMinute > 0) espeak_SetParameter(espeakRATE, request.wordsPerMinute, 0);
-    if (request.pitch >= 0) espeak_SetParameter(espeakPITCH, request.pitch, 0);
+    espeak_SetParameter(espeakRATE, request.wordsPerMinute > 0 ? request.wordsPerMinute : 175, 0);
+    espeak_SetParameter(espeakPITCH, request.pitch >= 0 ? request.pitch : 50, 0);
 
     SynthesizedSpeech out;
     out.sampleRate = sampleRate_;
