@@ -13,7 +13,8 @@ Labels:
   tool only (the product never depends on it). Each ARPAbet phone is a "word" of a JSGF grammar
   that spells the transcript (every dictionary pronunciation allowed, optional pauses), so the
   decoder's word times are phone times. Phones map to the common set by config/phonemes/arpabet.toml.
-  The words' outer edges are then moved in over room tone (trim_to_voice, below). The British
+  Its times are moved to the centre of its analysis window (POCKETSPHINX_HALF_WINDOW), and the
+  words' outer edges then in over room tone (trim_to_voice, below). The British
   klettres speaker's letters are spelled from espeak-ng's en-gb reading ("zed"), as below.
 - words known in Italian or Spanish (asterisk prompts): the same aligner, each word spelled in
   the nearest English phones from espeak-ng's phonemisation (config/corpus/espeak-arpabet.toml).
@@ -290,6 +291,15 @@ def grammar(spelled):
     return f"#JSGF V1.0;\ngrammar align;\npublic <s> = [sil] {body} [sil];\n"
 
 
+# pocketsphinx reports frame k at k * 10 ms, the start of the window (-wlen 0.025625 s, its
+# default) whose features decided it; the centre of that window, half of it later, is where the
+# sound was. Our aligner's boundaries on the English dev words lay a median 8 ms (ktuberling) and
+# 8 to 13 ms (klettres) after pocketsphinx's at vowel-consonant changes, in both directions,
+# and within a few milliseconds of festvox-ru's own labels either way (a median -4 ms into a
+# vowel, +6 ms out of one): the shift is pocketsphinx's.
+POCKETSPHINX_HALF_WINDOW = 0.025625 / 2
+
+
 def align(wav, spelled, work, phones):
     (work / "g.jsgf").write_text(grammar(spelled))
     cmd = ["pocketsphinx_continuous", "-infile", str(wav), "-hmm", str(MODEL / "en-us"),
@@ -302,7 +312,11 @@ def align(wav, spelled, work, phones):
         fields = line.split()
         if len(fields) != 4 or fields[1][0].isalpha():
             continue
-        word, start, end = fields[0], float(fields[1]), float(fields[2]) + 0.01
+        # pocketsphinx stamps a frame with the start of its 25.6 ms window: the sound it heard
+        # there lies half a window later (see POCKETSPHINX_HALF_WINDOW).
+        word = fields[0]
+        start = float(fields[1]) + POCKETSPHINX_HALF_WINDOW
+        end = float(fields[2]) + 0.01 + POCKETSPHINX_HALF_WINDOW
         if word.startswith("ph_"):
             name = phones[word[3:]]
         elif word in ("<sil>", "sil", "<s>", "</s>") or word.startswith("["):
@@ -385,6 +399,7 @@ def write_lab(path, segments, duration):
     # to the millisecond first, as written: a sliver shorter than that would read as a segment
     # that ends before it starts
     segments = [(round(a, 3), round(b, 3), name) for a, b, name in segments if round(b, 3) > round(a, 3)]
+    duration = round(duration, 3)
     for start, end, name in segments:
         if merged and merged[-1][2] == name and abs(merged[-1][1] - start) < 0.015:
             merged[-1] = (merged[-1][0], end, name)
@@ -395,7 +410,8 @@ def write_lab(path, segments, duration):
         for start, end, name in merged:
             if start > last + 0.015:
                 f.write(f"{last:.3f}\t{start:.3f}\tsil\n")
-            start = max(start, last)
+                last = start
+            start = last  # a gap under 15 ms (or an overlap) goes to the segment after it
             end = min(end, duration)
             if end > start:
                 f.write(f"{start:.3f}\t{end:.3f}\t{name}\n")

@@ -91,6 +91,28 @@ class TrimToVoice(unittest.TestCase):
 
 
 class WriteLab(unittest.TestCase):
+    def rows(self, segments, duration):
+        with tempfile.TemporaryDirectory() as tmp:
+            lab = Path(tmp) / "x.lab"
+            labeller.write_lab(lab, segments, duration)
+            return [(float(a), float(b), c) for a, b, c in
+                    (line.split("\t") for line in lab.read_text().splitlines())]
+
+    def test_the_labels_cover_the_file_without_gaps(self):
+        # pocketsphinx's times moved by half its window: the first starts 13 ms in
+        rows = self.rows([(0.0128, 0.2128, "sil"), (0.2128, 0.4, "aa"), (0.45, 0.6, "d")], 0.7)
+        self.assertEqual(rows[0][0], 0.0)
+        for before, after in zip(rows, rows[1:]):
+            self.assertEqual(before[1], after[0])
+        self.assertEqual(rows[-1][1], 0.7)
+        self.assertIn((0.4, 0.45, "sil"), rows)  # a real pause stays one
+
+    def test_a_file_ending_within_a_millisecond_of_the_last_segment_gets_no_empty_one(self):
+        rows = self.rows([(0.0, 0.583, "ah"), (0.583, 0.8201, "d"), (0.8201, 0.83, "sil")],
+                         0.820125)
+        for start, end, _ in rows:
+            self.assertLess(start, end)
+
     def test_slivers_are_dropped_and_silences_merged(self):
         with tempfile.TemporaryDirectory() as tmp:
             lab = Path(tmp) / "x.lab"
