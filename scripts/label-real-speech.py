@@ -331,14 +331,22 @@ def align(wav, spelled, work, phones):
 # pocketsphinx's silence model does not fit every room: on the ktuberling words it ran the last
 # phone a median 60 ms (a tenth of the words, 170 ms or more) into room tone after the voice had
 # stopped, and began the first 40 ms early ("ball": /l/ to 0.75 s, the voice gone at 0.63 s and
-# the room hum alone after it). So the outer edges of the words are moved in over frames that are
-# plainly room tone: within ROOM_DB of the recording's quietest frames (its room) and without the
-# zero crossings of a fricative. Only edges move, only inwards, and a phone left with no sound
-# becomes silence; pauses between words stay the aligner's (an endpoint detector in the manner of
-# Rabiner & Sambur 1975, with the room measured on the file's quietest frames).
-ROOM_DB = 10.0          # dB above the quietest frames that still count as room
-ROOM_FRAMES = 10        # the quietest frames that measure the room
+# the room hum alone after it); elsewhere it began a word 60 to 80 ms after the voice ("earth",
+# "rocket": the first vowel's harmonics under its silence) and ended a faint final fricative
+# where it was still heard ("earth": /θ/ to 0.49 s, its hiss to 0.63 s). So the outer edges of
+# the words are moved to where the sound starts and stops: in over frames that are plainly room
+# tone, out over frames that are plainly sound, up to MAX_EXTEND. Sound is a frame ROOM_DB over
+# the room (the tenth percentile of the frames, digital silence aside: klettres-en-gb's files
+# are padded with it around a recording 35 dB louder), or a fricative's zero crossings
+# FRICATIVE_DB over it. Only the outer edges move; a phone left with no sound becomes silence;
+# pauses between words stay the aligner's (an endpoint detector in the manner of Rabiner &
+# Sambur 1975, with the room measured on the file's quieter frames).
+ROOM_DB = 10.0          # dB above the room that is sound, whatever it is
+FRICATIVE_DB = 4.0      # ... and that is sound with a fricative's zero crossings
+ROOM_FRAMES = 10        # frames (heard, not padding) enough to measure the room
+DIGITAL_SILENCE_DB = 6.0  # frames below this (an RMS of 2 in 16 bits) are padding, not a room
 FRICATIVE_ZCR = 0.25    # zero crossings a sample above which a frame may be a fricative
+MAX_EXTEND = 0.15       # seconds an edge may move out
 
 
 def frame_levels(wav):
@@ -358,40 +366,62 @@ def frame_levels(wav):
     return levels
 
 
+def room_level(levels):
+    """The room's level: the tenth percentile of the frames, digital silence (padding a file was
+    cut with, and its fade into the recording) aside, or of all of them where nearly every frame
+    is such padding."""
+    heard = sorted(db for db, _ in levels if db >= DIGITAL_SILENCE_DB)
+    if len(heard) < ROOM_FRAMES:
+        heard = sorted(db for db, _ in levels)
+    return heard[len(heard) // 10]
+
+
+def voice_edges(levels, first, last):
+    """Where the sound around the words [first, last] s starts and stops, in seconds."""
+    room = room_level(levels)
+
+    def sound(i):
+        db, zcr = levels[i]
+        return db >= room + ROOM_DB or (zcr >= FRICATIVE_ZCR and db >= room + FRICATIVE_DB)
+
+    n, reach = len(levels), int(round(MAX_EXTEND * 100))
+    begin = min(int(round(first * 100)), n)
+    if begin < n and sound(begin):  # out, over sound just before
+        floor = max(0, begin - reach)
+        while begin > floor and sound(begin - 1):
+            begin -= 1
+    else:  # in, over room
+        while begin < n and not sound(begin):
+            begin += 1
+    end = min(int(round(last * 100)), n)
+    if end > 0 and sound(end - 1):
+        ceiling = min(n, end + reach)
+        while end < ceiling and sound(end):
+            end += 1
+    else:
+        while end > begin and not sound(end - 1):
+            end -= 1
+    return begin / 100, end / 100
+
+
 def trim_to_voice(segments, wav):
-    """segments with the words' outer edges moved in over room tone (see above)."""
+    """segments with the words' outer edges moved to where the sound starts and stops (above)."""
     levels = frame_levels(wav)
-    if len(levels) < 2 * ROOM_FRAMES:
-        return segments
-    quietest = sorted(db for db, _ in levels)[:ROOM_FRAMES]
-    ceiling = sum(quietest) / len(quietest) + ROOM_DB
-
-    def room(i):
-        return levels[i][0] < ceiling and levels[i][1] < FRICATIVE_ZCR
-
     spoken = [i for i, s in enumerate(segments) if s[2] != "sil"]
-    if not spoken:
+    if len(levels) < 2 * ROOM_FRAMES or not spoken:
         return segments
-    first, last = segments[spoken[0]][0], segments[spoken[-1]][1]
-    begin = min(int(round(first * 100)), len(levels))
-    while begin < len(levels) and room(begin):
-        begin += 1
-    end = min(int(round(last * 100)), len(levels))
-    while end > begin and room(end - 1):
-        end -= 1
-    voice_start, voice_end = max(first, begin / 100), min(last, end / 100)
-    trimmed = []
-    for start, stop, name in segments:
-        if name != "sil":
-            inner = (max(start, voice_start), min(stop, voice_end))
-            if inner[1] - inner[0] < 0.01:
-                name = "sil"
-            elif inner != (start, stop):
-                trimmed += [(start, inner[0], "sil"), (inner[0], inner[1], name),
-                            (inner[1], stop, "sil")]
-                continue
-        trimmed.append((start, stop, name))
-    return [s for s in trimmed if s[1] > s[0]]
+    words = segments[spoken[0]:spoken[-1] + 1]
+    voice_start, voice_end = voice_edges(levels, words[0][0], words[-1][1])
+    words[0] = (min(words[0][0], voice_start),) + words[0][1:]
+    words[-1] = words[-1][:1] + (max(words[-1][1], voice_end), words[-1][2])
+    moved = [(segments[0][0], voice_start, "sil")]
+    for start, stop, name in words:  # they tile [voice_start, voice_end] once clipped to it
+        start, stop = max(start, voice_start), min(stop, voice_end)
+        if stop - start < 0.01 and name != "sil":
+            name = "sil"  # a phone left with no sound
+        moved.append((start, stop, name))
+    moved.append((voice_end, segments[-1][1], "sil"))
+    return [s for s in moved if s[1] > s[0]]
 
 
 def write_lab(path, segments, duration):

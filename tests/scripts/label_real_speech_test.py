@@ -21,12 +21,15 @@ RATE = 16000
 
 def write_wav(path, pieces, offset=0):
     """pieces: (seconds, kind) with kind 'room' (a quiet 50 Hz hum), 'vowel' (a loud 200 Hz
-    buzz with harmonics) or 'hiss' (a faint fricative: white noise less than 10 dB over the room)."""
+    buzz with harmonics), 'hiss' (a faint fricative: white noise less than 10 dB over the room),
+    'noisy room' (the hum and a louder hiss) or 'padding' (digital silence)."""
     rng = random.Random(1)
     samples, t = [], 0
     for seconds, kind in pieces:
         for _ in range(int(seconds * RATE)):
-            x = 30 * math.sin(2 * math.pi * 50 * t / RATE)
+            x = 30 * math.sin(2 * math.pi * 50 * t / RATE) if kind != "padding" else 0
+            if kind == "noisy room":
+                x += rng.gauss(0, 300)
             if kind == "vowel":
                 x += sum(4000 / k * math.sin(2 * math.pi * 200 * k * t / RATE) for k in range(1, 6))
             elif kind == "hiss":
@@ -62,6 +65,25 @@ class TrimToVoice(unittest.TestCase):
         got = self.trimmed(pieces, [(0.0, 0.2, "sil"), (0.2, 0.7, "aa"), (0.7, 1.0, "sil")])
         self.assertAlmostEqual([s for s in got if s[2] == "aa"][0][0], 0.3, delta=0.015)
 
+    def test_a_first_phone_begun_after_the_voice_starts_with_it(self):
+        # "earth": pocketsphinx's silence covered the first 60 ms of the vowel
+        pieces = [(0.3, "room"), (0.4, "vowel"), (0.3, "room")]
+        got = self.trimmed(pieces, [(0.0, 0.36, "sil"), (0.36, 0.7, "er"), (0.7, 1.0, "sil")])
+        self.assertAlmostEqual([s for s in got if s[2] == "er"][0][0], 0.3, delta=0.015)
+        self.assertEqual(got[0], (0.0, got[1][0], "sil"))
+
+    def test_an_edge_moves_out_no_further_than_max_extend(self):
+        pieces = [(0.2, "room"), (0.8, "vowel"), (0.2, "room")]
+        got = self.trimmed(pieces, [(0.0, 0.6, "sil"), (0.6, 0.8, "aa"), (0.8, 1.2, "sil")])
+        aa = [s for s in got if s[2] == "aa"][0]
+        self.assertAlmostEqual(aa[0], 0.6 - labeller.MAX_EXTEND, delta=0.015)
+
+    def test_a_faint_fricative_cut_short_runs_on_to_its_end(self):
+        pieces = [(0.3, "room"), (0.3, "vowel"), (0.3, "hiss"), (0.3, "room")]
+        got = self.trimmed(pieces, [(0.0, 0.3, "sil"), (0.3, 0.6, "er"), (0.6, 0.8, "th"),
+                                    (0.8, 1.2, "sil")])
+        self.assertAlmostEqual([s for s in got if s[2] == "th"][0][1], 0.9, delta=0.015)
+
     def test_a_faint_fricative_at_the_end_is_kept(self):
         # "earth": the /th/ is hardly louder than the room; its zero crossings tell it apart
         pieces = [(0.3, "room"), (0.3, "vowel"), (0.3, "hiss"), (0.3, "room")]
@@ -74,6 +96,15 @@ class TrimToVoice(unittest.TestCase):
         got = self.trimmed(pieces, [(0.0, 0.3, "sil"), (0.3, 0.6, "ih"), (0.6, 0.8, "r"),
                                     (0.8, 1.2, "sil")])
         self.assertNotIn("r", [s[2] for s in got])
+
+    def test_digital_padding_around_a_noisy_room_is_not_taken_for_the_room(self):
+        # klettres-en-gb: each recording padded with digital silence; its own room 35 dB louder
+        pieces = [(0.3, "padding"), (0.3, "noisy room"), (0.4, "vowel"), (0.3, "noisy room"),
+                  (0.3, "padding")]
+        got = self.trimmed(pieces, [(0.0, 0.6, "sil"), (0.6, 1.0, "eh"), (1.0, 1.6, "sil")])
+        eh = [s for s in got if s[2] == "eh"][0]
+        self.assertAlmostEqual(eh[0], 0.6, delta=0.015)
+        self.assertAlmostEqual(eh[1], 1.0, delta=0.015)
 
     def test_a_dc_offset_does_not_hide_the_voice(self):
         # a few recordings sit far from zero: measured about each frame's mean, the room is
