@@ -168,6 +168,11 @@ def festvox_ru_items(root):
         yield lab.stem, base / "wav" / f"{lab.stem}.wav", None, segments, texts.get(lab.stem)
 
 
+# Written beside each speaker's files; labels an older labeller made (another version) are made
+# again. Raise it whenever the labels would come out otherwise.
+# 2: pocketsphinx's times at its window's centre, the words' outer edges where the sound is.
+LABELLER_VERSION = "2"
+
 # Items whose labels come from the project's own aligner later (train-templates.sh), not here.
 BY_ALIGNER = "aligner"
 
@@ -486,6 +491,9 @@ def main():
                 continue
             folder = args.out / split / speaker
             folder.mkdir(parents=True, exist_ok=True)
+            # Labels an older labeller wrote are made again (the WAVs are kept).
+            stamp = folder / ".labeller"
+            current = stamp.exists() and stamp.read_text().strip() == LABELLER_VERSION
             made = skipped = 0
             for name, audio, words, segments, text in items_of(args.root, source):
                 if args.subset and made >= args.subset:
@@ -493,7 +501,7 @@ def main():
                 wav, lab = folder / f"{name}.wav", folder / f"{name}.lab"
                 if words == BY_ALIGNER and not wav.exists():
                     convert(audio, wav)
-                if wav.exists() and (lab.exists() or words == BY_ALIGNER):
+                if wav.exists() and ((lab.exists() and current) or words == BY_ALIGNER):
                     write_text(folder / f"{name}.txt", text)
                     made += 1
                     continue
@@ -509,11 +517,14 @@ def main():
                     segments = trim_to_voice(align(wav, spelled, work, phones), wav)
                     if not any(s[2] != "sil" for s in segments):
                         wav.unlink()
+                        lab.unlink(missing_ok=True)
                         skipped += 1
                         continue
                 write_lab(lab, segments, duration)
                 write_text(folder / f"{name}.txt", text)
                 made += 1
+            if not args.subset or made >= args.subset:  # every item this run asked for
+                stamp.write_text(LABELLER_VERSION + "\n")
             log(f"{split}/{speaker}: {made} files ({skipped} skipped: words unknown or not aligned)")
 
 
