@@ -14,8 +14,8 @@ Labels:
   that spells the transcript (every dictionary pronunciation allowed, optional pauses), so the
   decoder's word times are phone times. Phones map to the common set by config/phonemes/arpabet.toml.
   Its times are moved to the centre of its analysis window (POCKETSPHINX_HALF_WINDOW), and the
-  words' outer edges then in over room tone (trim_to_voice, below). The British
-  klettres speaker's letters are spelled from espeak-ng's en-gb reading ("zed"), as below.
+  words' outer edges then to where the sound starts and stops (trim_to_voice, below). The
+  British klettres speaker's letters are spelled from espeak-ng's en-gb reading ("zed").
 - words known in Italian or Spanish (asterisk prompts): the same aligner, each word spelled in
   the nearest English phones from espeak-ng's phonemisation (config/corpus/espeak-arpabet.toml).
 - fillets-ng (Czech, Dutch): the game's dialogue clips, whose words are in its scripts
@@ -433,7 +433,8 @@ def write_lab(path, segments, duration):
     merged = []
     # to the millisecond first, as written: a sliver shorter than that would read as a segment
     # that ends before it starts
-    segments = [(round(a, 3), round(b, 3), name) for a, b, name in segments if round(b, 3) > round(a, 3)]
+    rounded = ((round(a, 3), round(b, 3), name) for a, b, name in segments)
+    segments = [s for s in rounded if s[1] > s[0]]
     duration = round(duration, 3)
     for start, end, name in segments:
         if merged and merged[-1][2] == name and abs(merged[-1][1] - start) < 0.015:

@@ -57,6 +57,9 @@ int onSynth(short* wav, int count, espeak_EVENT* events) {
     return 0;  // continue synthesis
 }
 
+// espeak-ng's own pitch when none is asked for (espeak_SetParameter: 0..100).
+constexpr int kDefaultPitch = 50;
+
 // The voice file for a language code ("en-gb" -> "gmw/en"): espeak_SetVoiceByName knows voice
 // names and file names, but users name voices by language, as the espeak-ng command does.
 std::string voiceFileForLanguage(const std::string& language) {
@@ -201,8 +204,11 @@ SynthesizedSpeech EspeakSynthesizer::synthesize(const SynthesisRequest& request)
     if (!selectVoice(request.voice))
         throw InputError("espeak-ng: unknown voice '" + request.voice +
                          "' (list them with: espeak-ng --voices)");
-    espeak_SetParameter(espeakRATE, request.wordsPerMinute > 0 ? request.wordsPerMinute : 175, 0);
-    espeak_SetParameter(espeakPITCH, request.pitch >= 0 ? request.pitch : 50, 0);
+    // Always set: espeak-ng keeps the last request's rate and pitch (and a voice may change
+    // them), so a request without them would otherwise read as the one before did.
+    espeak_SetParameter(espeakRATE,
+                        request.wordsPerMinute > 0 ? request.wordsPerMinute : espeakRATE_NORMAL, 0);
+    espeak_SetParameter(espeakPITCH, request.pitch >= 0 ? request.pitch : kDefaultPitch, 0);
 
     SynthesizedSpeech out;
     out.sampleRate = sampleRate_;
