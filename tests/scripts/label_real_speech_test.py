@@ -121,6 +121,29 @@ class TrimToVoice(unittest.TestCase):
         self.assertEqual(self.trimmed(pieces, segments)[1:5], segments[1:5])
 
 
+class SpeakerList(unittest.TestCase):
+    """config/corpus/real-speakers.txt: every line's split is one the scripts know."""
+
+    def load(self, text):
+        with tempfile.TemporaryDirectory() as d:
+            path = Path(d) / "speakers.txt"
+            path.write_text(text)
+            return labeller.load_speakers(path)
+
+    def test_the_shipped_list_has_every_split(self):
+        speakers = labeller.load_speakers(SCRIPT.parent.parent / "config/corpus/real-speakers.txt")
+        self.assertEqual({split for _, split, _ in speakers}, {"train", "dev", "tune"})
+
+    def test_a_tune_voice_is_read_with_its_source(self):
+        self.assertEqual(self.load("# a comment\nfillets-cs-v  tune  fillets:cs:v  # the fish\n"),
+                         [("fillets-cs-v", "tune", "fillets:cs:v")])
+
+    def test_an_unknown_split_names_the_line(self):
+        with self.assertRaises(SystemExit) as raised:
+            self.load("klettres-en  dev  klettres:en\nsomeone  test  klettres:en\n")
+        self.assertIn(":2: expected 'SPEAKER train|dev|tune SOURCE'", str(raised.exception))
+
+
 class WriteLab(unittest.TestCase):
     def rows(self, segments, duration):
         with tempfile.TemporaryDirectory() as tmp:
