@@ -36,7 +36,8 @@ FrameAnalyzer::FrameAnalyzer(const AnalysisConfig& config) : config_(config) {
     if (config_.spectrumByFft)
         fft_ = std::make_unique<FftLpcSpectrum>(config_.spectrumBins);
     else
-        direct_ = std::make_unique<DirectLpcSpectrum>(config_.order, config_.spectrumBins);
+        direct_ =
+            std::make_unique<DirectLpcSpectrum>(config_.order, config_.spectrumBins, config_.warp);
     if (!config_.spectrumMean.empty()) normaliser_.emplace(config_);
 }
 

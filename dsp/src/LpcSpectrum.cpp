@@ -16,14 +16,16 @@ float toDb(float re, float im) {
 }
 }  // namespace
 
-DirectLpcSpectrum::DirectLpcSpectrum(int order, int bins) : order_(order), bins_(bins) {
+DirectLpcSpectrum::DirectLpcSpectrum(int order, int bins, double warp)
+    : order_(order), bins_(bins) {
     // Tables by coefficient, then bin: the loop over bins is the inner one and vectorises, and
     // each bin's sums are still taken in order of the coefficients.
     const auto n = static_cast<std::size_t>(bins) * static_cast<std::size_t>(order + 1);
     cos_.resize(n);
     sin_.resize(n);
     for (int m = 0; m < bins; ++m) {
-        const double w = std::numbers::pi * m / bins;
+        // Above π/warp (warp > 1) the grid stays at the band's top: nothing is heard there.
+        const double w = std::min(std::numbers::pi, warp * std::numbers::pi * m / bins);
         for (int i = 0; i <= order; ++i) {
             cos_[i * bins + m] = static_cast<float>(std::cos(w * i));
             sin_[i * bins + m] = static_cast<float>(std::sin(w * i));

@@ -2,7 +2,9 @@
 // ω_m = π·m / bins (Lewis: "evaluating the magnitude of 1/A(z) at points on the upper half of
 // the unit circle ... effectively a DFT of the zero-extended coefficient sequence").
 // Two ways: direct evaluation with cached cos/sin tables, or a zero-padded FFT; bench/ measures
-// which is faster at a given order.
+// which is faster at a given order. Direct evaluation can also read the envelope on a warped grid,
+// ω_m = min(π, warp·π·m / bins): a vocal-tract-length warp (AnalysisConfig::warp; Lee & Rose
+// 1996).
 #pragma once
 
 #include <span>
@@ -12,7 +14,7 @@ namespace lipsyncd::dsp {
 
 class DirectLpcSpectrum {
   public:
-    DirectLpcSpectrum(int order, int bins);
+    DirectLpcSpectrum(int order, int bins, double warp = 1.0);
     void evaluate(std::span<const float> a, std::span<float> outDb);
 
   private:

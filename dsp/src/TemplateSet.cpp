@@ -48,6 +48,8 @@ AnalysisConfig readAnalysis(const json& a, const std::string& source) {
         c.meanPriorSeconds = member<double>(a, "mean_prior_seconds", p, source);
         c.meanMemorySeconds = member<double>(a, "mean_memory_seconds", p, source);
     }
+    // Optional: a speaker's vocal-tract-length warp (lipsync calibrate), 1 when absent.
+    if (a.contains("warp")) c.warp = member<double>(a, "warp", p, source);
     try {
         c.validate();
     } catch (const InputError& e) {
@@ -73,6 +75,7 @@ json writeAnalysis(const AnalysisConfig& c) {
         extra.push_back("level");
         a["level_peak_decay"] = c.levelPeakDecayDbPerSecond;
     }
+    if (c.warp != 1.0) a["warp"] = c.warp;
     if (!c.spectrumMean.empty()) {
         a["spectrum_mean"] = rounded(c.spectrumMean);
         a["mean_prior_seconds"] = c.meanPriorSeconds;

@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/dsp.hpp>
 #include <nlohmann/json.hpp>
@@ -250,6 +253,74 @@ TEST(LipsyncCli, CalibrateFromReadSpeechReplacesTheClassesItHeard) {
     EXPECT_EQ(own.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
     ASSERT_TRUE(own.classNetwork && base.classNetwork);
     EXPECT_EQ(own.classNetwork->outputWeights, base.classNetwork->outputWeights);
+}
+
+// A copy of a WAV file whose header claims `factor` times its sample rate: played slower, its
+// formants lie lower by that factor, as a speaker with a longer vocal tract's do.
+void copyAtRate(const fs::path& from, const fs::path& to, double factor) {
+    std::ifstream in(from, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto u32 = [&](std::size_t at) {
+        std::uint32_t v = 0;
+        for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(bytes[at + k]);
+        return v;
+    };
+    auto put32 = [&](std::size_t at, std::uint32_t v) {
+        for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>((v >> (8 * k)) & 0xff);
+    };
+    for (std::size_t at = 12; at + 8 <= bytes.size(); at += 8 + u32(at + 4) + (u32(at + 4) & 1)) {
+        if (bytes.compare(at, 4, "fmt ") != 0) continue;
+        const auto rate = static_cast<std::uint32_t>(std::lround(u32(at + 12) * factor));
+        const auto blockAlign = static_cast<unsigned char>(bytes[at + 20]);
+        put32(at + 12, rate);
+        put32(at + 16, rate * blockAlign);
+        break;
+    }
+    std::ofstream(to, std::ios::binary) << bytes;
+}
+
+double warpOf(const fs::path& templates) {
+    return dsp::TemplateSet::load(templates).analysis.warp;
+}
+
+// With read speech, calibrate chooses the speaker's vocal-tract-length warp: none for the voice
+// the templates know, below 1 for the same lines with every formant 12 % lower.
+TEST(LipsyncCli, CalibrateChoosesAWarpForAVoiceWithLowerFormants) {
+    const auto plain = scratchDir("cli_calibrate_warp_plain");
+    const auto low = scratchDir("cli_calibrate_warp_low");
+    const char* lines[] = {"Hello puppet, open wide and sing to me.",
+                           "Bob bought a big bag of beans by the bay.",
+                           "Why do you sit so still when the show is on?",
+                           "Father asked the man to carry the heavy boxes."};
+    for (int i = 0; i < 4; ++i) {
+        const auto name = "s" + std::to_string(i);
+        ASSERT_EQ(
+            runLipsync({"say", lines[i], "--wav", (plain / (name + ".wav")).string()}).exitCode, 0);
+        copyAtRate(plain / (name + ".wav"), low / (name + ".wav"), 0.88);
+        for (const auto& dir : {plain, low}) std::ofstream(dir / (name + ".txt")) << lines[i];
+    }
+    const auto plainOut = plain.parent_path() / "calibrated-plain.json";
+    const auto lowOut = low.parent_path() / "calibrated-low.json";
+    const auto r = runLipsync({"calibrate", plain.string(), "-o", plainOut.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("warp 0.85: the audio alone hears"), std::string::npos) << r.err;
+    EXPECT_EQ(warpOf(plainOut), 1.0);
+    const auto l = runLipsync({"calibrate", low.string(), "-o", lowOut.string()});
+    ASSERT_EQ(l.exitCode, 0) << l.err;
+    EXPECT_LE(warpOf(lowOut), 0.9) << l.err;
+}
+
+// --warp fixes the warp instead; a value out of range is named.
+TEST(LipsyncCli, CalibrateTakesAFixedWarpAndRejectsABadOne) {
+    const auto dir = scratchDir("cli_calibrate_fixed_warp");
+    ASSERT_EQ(runLipsync({"say", "ahhhhhh", "--wav", (dir / "aa.wav").string()}).exitCode, 0);
+    const auto out = dir.parent_path() / "calibrated-fixed.json";
+    const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string(), "--warp", "0.9"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_DOUBLE_EQ(warpOf(out), 0.9);
+    const auto bad = runLipsync({"calibrate", dir.string(), "-o", out.string(), "--warp", "2"});
+    EXPECT_NE(bad.exitCode, 0);
+    EXPECT_NE(bad.err.find("--warp"), std::string::npos) << bad.err;
 }
 
 // train --keep-templates: only the networks asked for are trained, on the labelled speech given;

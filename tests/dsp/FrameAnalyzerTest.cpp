@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <lipsyncd/dsp.hpp>
+#include <numbers>
 #include <random>
 
 #include "../../dsp/src/LpcSpectrum.hpp"
@@ -61,6 +63,51 @@ TEST(LpcSpectrum, DirectAndFftEvaluationAgree) {
         fft.evaluate(a, f);
         for (int m = 0; m < 32; ++m) EXPECT_NEAR(d[m], f[m], 1e-3) << m;
     }
+}
+
+// A warp reads the envelope at warp times each bin's frequency: a resonance at f shows in the
+// bin of f / warp, and warp 1 is the grid as it was.
+TEST(LpcSpectrum, AWarpMovesAResonanceToItsWarpedBin) {
+    const int bins = 32;
+    const double f = 0.3;  // of the band: bin 9.6 unwarped
+    const double r = 0.97, w = std::numbers::pi * f;
+    const std::vector<float> a = {1.0f, static_cast<float>(-2 * r * std::cos(w)),
+                                  static_cast<float>(r * r)};
+    auto peakBin = [&](double warp) {
+        DirectLpcSpectrum spectrum(2, bins, warp);
+        std::vector<float> db(bins);
+        spectrum.evaluate(a, db);
+        return static_cast<int>(std::max_element(db.begin(), db.end()) - db.begin());
+    };
+    EXPECT_EQ(peakBin(1.0), 10);
+    EXPECT_EQ(peakBin(0.8), 12);  // 9.6 / 0.8
+    EXPECT_EQ(peakBin(1.2), 8);   // 9.6 / 1.2
+    DirectLpcSpectrum plain(2, bins), none(2, bins, 1.0);
+    std::vector<float> x(bins), y(bins);
+    plain.evaluate(a, x);
+    none.evaluate(a, y);
+    EXPECT_EQ(x, y);
+}
+
+TEST(AnalysisConfig, AWarpIsBoundedAndNeedsDirectEvaluation) {
+    auto errorOf = [](AnalysisConfig c) {
+        try {
+            c.validate();
+        } catch (const lipsyncd::InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    AnalysisConfig c;
+    c.warp = 0.9;
+    EXPECT_EQ(errorOf(c), "");
+    c.warp = 1.6;
+    EXPECT_NE(errorOf(c).find("analysis.warp: must be 0.7..1.4"), std::string::npos);
+    c.warp = std::nan("");
+    EXPECT_NE(errorOf(c).find("analysis.warp"), std::string::npos);
+    c.warp = 0.9;
+    c.spectrumByFft = true;
+    EXPECT_NE(errorOf(c).find("analysis.warp: needs direct evaluation"), std::string::npos);
 }
 
 TEST(AnalysisConfig, RejectsNonsenseNamingTheField) {

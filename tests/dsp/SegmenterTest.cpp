@@ -120,6 +120,13 @@ TEST(TemplateSet, MalformedFilesNameTheField) {
                 R"(, "bin_weights": [1,1,1,1], "classes": [{"phoneme": "aa", "spectra": "no"}]})")
             .find("classes[0].spectra"),
         std::string::npos);
+    // A speaker's warp (lipsync calibrate) is kept, and one out of range named.
+    EXPECT_NE(errorOf(R"({"format": "lipsyncd-templates", "version": 1, "analysis": {"rate": 10000,
+        "hop": 0.01, "window": 0.025, "order": 12, "pre_emphasis": 0.97, "lag_window_hz": 60,
+        "white_noise_correction": 0.0001, "bins": 4, "warp": 3}, "bin_weights": [1,1,1,1],
+        "classes": []})")
+                  .find("analysis.warp: must be 0.7..1.4"),
+              std::string::npos);
     // Extra features: unknown names are refused; known ones widen every vector.
     const std::string extra =
         R"({"format": "lipsyncd-templates", "version": 1, "analysis": {"rate": 10000,

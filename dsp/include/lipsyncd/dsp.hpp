@@ -146,6 +146,11 @@ struct AnalysisConfig {
     std::vector<float> spectrumMean;
     double meanPriorSeconds = 2;
     double meanMemorySeconds = 10;
+    // Vocal-tract-length warp (Lee & Rose 1996): the spectrum's bins are read at warp times
+    // their frequencies (up to the analysis band's top), so a speaker whose formants lie lower
+    // than the templates' (a longer vocal tract) is heard with them where the templates expect
+    // them, at warp < 1. 1: none. Chosen per speaker by `lipsync calibrate` (0.7..1.4).
+    double warp = 1.0;
 
     int featureCount() const { return spectrumBins + errorFeature + levelFeature; }
 
