@@ -161,13 +161,12 @@ void runCalibrate(const CalibrateOptions& o) {
     auto base = o.base.empty() ? dsp::TemplateSet::loadDefault()
                                : dsp::TemplateSet::load(findDataFile(o.base));
     if (!std::filesystem::is_directory(o.folder)) throw InputError(o.folder + ": not a folder");
+    const std::optional<double> given =
+        o.warp == "auto" ? std::nullopt : std::optional(parseWarp(o.warp));
     const auto read = alignReadSpeech(o, base);
-    const char* why = o.warp != "auto" ? "as given"
-                      : read.empty()   ? "none: no words to judge it by"
-                                       : "chosen";
-    base.analysis.warp = o.warp != "auto" ? parseWarp(o.warp)
-                         : read.empty()   ? 1.0
-                                          : chooseWarp(read, base);
+    const char* why = "as given";
+    if (!given) why = read.empty() ? "none: no words to judge it by" : "chosen";
+    base.analysis.warp = given ? *given : read.empty() ? 1.0 : chooseWarp(read, base);
     std::cerr << "lipsync calibrate: warp " << std::fixed << std::setprecision(2)
               << base.analysis.warp << " (" << why << ")\n";
     dsp::TrainingOptions training;
