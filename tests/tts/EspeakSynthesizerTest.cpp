@@ -113,9 +113,10 @@ std::vector<std::string> classesOf(const std::string& text, const std::string& v
     return out;
 }
 
-// French, Spanish, Bulgarian and Romanian lines are said and aligned through their own maps
-// (config/phonemes/espeak-fr.toml, -es, -bg, -ro): the lips close for m, b and p, meet the teeth
-// for f and v, round for ou and u, and the jaw opens for a, whatever the language's own letters.
+// French, Spanish, Bulgarian, Romanian and Czech lines are said and aligned through their own
+// maps (config/phonemes/espeak-fr.toml, -es, -bg, -ro, -cs): the lips close for m, b and p, meet
+// the teeth for f and v, round for ou and u, and the jaw opens for a, whatever the language's own
+// letters.
 TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
     EXPECT_EQ(classesOf("Bonjour, ma petite fille.", "fr", 1),
               (std::vector<std::string>{"bmp", "ah"}));
@@ -131,6 +132,13 @@ TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
               (std::vector<std::string>{"bmp", "l", "ao", "d", "ao", "f", "eh"}));
     EXPECT_EQ(classesOf("Mama mănâncă fructe bune.", "ro", 3),
               (std::vector<std::string>{"bmp", "w", "d", "eh"}));
+    EXPECT_EQ(classesOf("Máma vaří.", "cs", 0),
+              (std::vector<std::string>{"bmp", "aa", "bmp", "aa"}));
+    EXPECT_EQ(classesOf("řeka", "cs", 0), (std::vector<std::string>{"r", "eh", "kg", "aa"}));
+    EXPECT_EQ(classesOf("krk", "cs", 0),
+              (std::vector<std::string>{"kg", "r", "kg"}));  // syllabic r
+    EXPECT_EQ(classesOf("těch dalších", "cs", 0),            // ch voiced before d (Q)
+              (std::vector<std::string>{"d", "eh", "kg"}));
 }
 
 // French espeak-ng says "tout le monde" as one dictionary entry, one word event whose length
