@@ -113,10 +113,10 @@ std::vector<std::string> classesOf(const std::string& text, const std::string& v
     return out;
 }
 
-// French, Spanish, Bulgarian, Romanian and Czech lines are said and aligned through their own
-// maps (config/phonemes/espeak-fr.toml, -es, -bg, -ro, -cs): the lips close for m, b and p, meet
-// the teeth for f and v, round for ou and u, and the jaw opens for a, whatever the language's own
-// letters.
+// French, Spanish, Bulgarian, Romanian, Czech and Dutch lines are said and aligned through their
+// own maps (config/phonemes/espeak-fr.toml, -es, -bg, -ro, -cs, -nl): the lips close for m, b and
+// p, meet the teeth for f and v, round for ou and u, and the jaw opens for a, whatever the
+// language's own letters.
 TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
     EXPECT_EQ(classesOf("Bonjour, ma petite fille.", "fr", 1),
               (std::vector<std::string>{"bmp", "ah"}));
@@ -139,6 +139,10 @@ TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
               (std::vector<std::string>{"kg", "r", "kg"}));  // syllabic r
     EXPECT_EQ(classesOf("těch dalších", "cs", 0),            // ch voiced before d (Q)
               (std::vector<std::string>{"d", "eh", "kg"}));
+    EXPECT_EQ(classesOf("Hallo pop.", "nl", 1), (std::vector<std::string>{"bmp", "ao", "bmp"}));
+    EXPECT_EQ(classesOf("wang", "nl", 0),  // w: the lower lip to the teeth
+              (std::vector<std::string>{"f", "aa", "d"}));
+    EXPECT_EQ(classesOf("goed", "nl", 0), (std::vector<std::string>{"kg", "w", "d"}));
 }
 
 // French espeak-ng says "tout le monde" as one dictionary entry, one word event whose length
