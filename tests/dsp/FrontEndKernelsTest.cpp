@@ -182,8 +182,9 @@ std::size_t checkDistancesAndLabels(const dsp::TemplateSet& t) {
             std::sort(order.begin(), order.end());
             // The label is the nearest class (unless the gate called the frame silent) wherever
             // the runner-up is not within rounding of it.
-            if (!label.silent && order.size() > 1 && order[1].first - order[0].first > 1e-3)
+            if (!label.silent && order.size() > 1 && order[1].first - order[0].first > 1e-3) {
                 EXPECT_EQ(label.phoneme, order[0].second) << "at " << label.time;
+            }
             ++compared;
         }
     }

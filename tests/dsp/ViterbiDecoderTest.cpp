@@ -96,7 +96,9 @@ TEST(ViterbiDecoder, FixedLagDecidesEveryFrameOnceAndAgreesWithOfflineOnClearInp
     for (std::size_t i = 0; i < in2.size(); ++i) {
         const auto out = decoder.push(in2[i].label, in2[i].distances);
         ASSERT_EQ(out.size(), i < 12 ? 0u : 1u) << "frame " << i;
-        if (!out.empty()) EXPECT_DOUBLE_EQ(out[0].time, in2[i - 12].label.time);
+        if (!out.empty()) {
+            EXPECT_DOUBLE_EQ(out[0].time, in2[i - 12].label.time);
+        }
     }
     EXPECT_EQ(decoder.finish().size(), 12u);
 }
