@@ -59,7 +59,10 @@ double parseWarp(const std::string& text) {
     } catch (const std::exception&) {
         used = 0;
     }
-    if (used != text.size() || !(w >= 0.7 && w <= 1.4))
+    using dsp::AnalysisConfig;  // the set's own bounds: a warp it would refuse is refused here
+    static_assert(AnalysisConfig::kMinWarp == 0.7 && AnalysisConfig::kMaxWarp == 1.4,
+                  "the message and --help name the bounds");
+    if (used != text.size() || !(w >= AnalysisConfig::kMinWarp && w <= AnalysisConfig::kMaxWarp))
         throw InputError("--warp: expected 'auto' or a number 0.7..1.4, got '" + text + "'");
     return w;
 }

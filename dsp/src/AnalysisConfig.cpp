@@ -41,7 +41,8 @@ void AnalysisConfig::validate() const {
             bad("mean_memory_seconds", "must be at least mean_prior_seconds and at most 3600 s");
     }
     if (!(levelPeakDecayDbPerSecond > 0)) bad("level_peak_decay", "must be > 0 dB/s");
-    if (!(warp >= 0.7 && warp <= 1.4)) bad("warp", "must be 0.7..1.4");
+    static_assert(kMinWarp == 0.7 && kMaxWarp == 1.4, "the message names the bounds");
+    if (!(warp >= kMinWarp && warp <= kMaxWarp)) bad("warp", "must be 0.7..1.4");
     if (spectrumByFft && warp != 1.0)
         bad("warp", "needs direct evaluation (an FFT's bins lie at fixed frequencies)");
 }

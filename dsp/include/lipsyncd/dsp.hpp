@@ -149,8 +149,9 @@ struct AnalysisConfig {
     // Vocal-tract-length warp (Lee & Rose 1996): the spectrum's bins are read at warp times
     // their frequencies (up to the analysis band's top), so a speaker whose formants lie lower
     // than the templates' (a longer vocal tract) is heard with them where the templates expect
-    // them, at warp < 1. 1: none. Chosen per speaker by `lipsync calibrate` (0.7..1.4).
+    // them, at warp < 1. 1: none. Chosen per speaker by `lipsync calibrate`.
     double warp = 1.0;
+    static constexpr double kMinWarp = 0.7, kMaxWarp = 1.4;  // validate()'s bounds
 
     int featureCount() const { return spectrumBins + errorFeature + levelFeature; }
 
