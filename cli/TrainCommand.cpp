@@ -105,7 +105,9 @@ void addTrainCommand(CLI::App& app) {
     auto o = std::make_shared<TrainOptions>();
     auto* cmd = app.add_subcommand(
         "train", "Train spectral templates from labelled audio (NAME.wav + NAME.lab folders)");
-    cmd->add_option("corpus", o->corpora, "Folders of NAME.wav + NAME.lab")
+    cmd->add_option("corpus", o->corpora,
+                    "Folders of NAME.wav + NAME.lab (a segment labelled with confidence 0, a "
+                    "fourth column, is not learnt)")
         ->required()
         ->check(CLI::ExistingDirectory);
     cmd->add_option("-o,--output", o->output, "Template file to write (JSON)")->required();

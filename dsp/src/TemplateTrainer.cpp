@@ -72,6 +72,15 @@ TemplateTrainer::TemplateTrainer(const TrainingOptions& options, const PhonemeSe
     options_.analysis.validate();
 }
 
+// A segment labelled with confidence 0 teaches nothing: the labeller marks what it doubts (a
+// class its aligner places badly in some recordings), and those frames are left out of the
+// templates and the networks alike.
+namespace {
+bool taught(const PhonemeSegment& label) {
+    return label.confidence > 0;
+}
+}  // namespace
+
 void TemplateTrainer::addFrame(const FrameFeatures& frame, std::size_t phoneme) {
     spectra_[phoneme].push_back(frame.spectrum);
 }
@@ -95,7 +104,7 @@ void TemplateTrainer::addUtterance(std::span<const FrameFeatures> frames,
         const bool middle = std::abs(f.time - 0.5 * (label.start + label.end)) <=
                             0.5 * options_.analysis.hopSeconds;
         if (!inside && !middle) continue;
-        if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb) continue;
+        if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb || !taught(label)) continue;
         if (const auto cls = set_->find(label.phoneme)) addFrame(f, *cls);
     }
 }
@@ -117,7 +126,7 @@ void TemplateTrainer::addNetworkFrames(std::span<const FrameFeatures> frames,
             cls[i] = -1;
             continue;
         }
-        cls[i] = static_cast<int>(*c);
+        cls[i] = taught(labels[seg]) ? static_cast<int>(*c) : -1;  // its height still counts
         if (const auto jaw = (*set_)[*c].jaw)
             height[i] = *jaw;
         else

@@ -177,3 +177,47 @@ TEST(ClassNetwork, TravelsWithTheTemplatesAndIsValidated) {
     bad.classNetwork->classes[1] = "aa";
     test::expectRejected(bad, "class_network.classes[1]: 'aa' listed twice");
 }
+
+// A labeller marks what it doubts with confidence 0 (scripts: a class its aligner places badly in
+// some recordings); those frames teach neither the templates nor the networks, and everything
+// else is learnt as before.
+TEST(TemplateTrainer, ASegmentLabelledWithConfidenceZeroTeachesNothing) {
+    const auto trainWithBilabials = [](float confidence) {
+        std::mt19937 rng(7);
+        TrainingOptions options;
+        options.analysis = AnalysisConfig{};
+        options.analysis.spectrumBins = 4;
+        options.clustersPerClass = 1;
+        options.jawHiddenUnits = 8;
+        options.classHiddenUnits = 8;
+        TemplateTrainer trainer(options, PhonemeSet::common());
+        for (int i = 0; i < 4; ++i) {
+            auto u = utterance(rng);
+            double t = u.labels.back().end;
+            for (int segment = 0; segment < 10; ++segment, t += 0.2) {
+                u.labels.push_back({t, t + 0.2, "bmp", confidence});
+                for (int k = 0; k < 20; ++k) {
+                    FrameFeatures f = u.frames.back();
+                    f.time = t + 0.005 + 0.01 * k;
+                    f.spectrum = {20, 20, -20, -20};
+                    u.frames.push_back(std::move(f));
+                }
+            }
+            trainer.addUtterance(u.frames, u.labels);
+        }
+        return trainer.build("test");
+    };
+    const auto classesOf = [](const TemplateSet& t) {
+        std::vector<std::string> names;
+        for (const auto& c : t.classes) names.push_back(c.phoneme);
+        return names;
+    };
+    const auto taught = trainWithBilabials(1.0f), doubted = trainWithBilabials(0.0f);
+    EXPECT_EQ(classesOf(taught), (std::vector<std::string>{"aa", "ih", "bmp"}));
+    ASSERT_TRUE(taught.classNetwork.has_value());
+    EXPECT_EQ(taught.classNetwork->classes, (std::vector<std::string>{"aa", "ih", "bmp"}));
+    EXPECT_EQ(classesOf(doubted), (std::vector<std::string>{"aa", "ih"}));
+    ASSERT_TRUE(doubted.classNetwork.has_value());
+    EXPECT_EQ(doubted.classNetwork->classes, (std::vector<std::string>{"aa", "ih"}));
+    EXPECT_TRUE(doubted.jawNetwork.has_value());
+}
