@@ -45,12 +45,19 @@ Utterance utterance(std::mt19937& rng, int segments = 40) {
     return u;
 }
 
-TemplateSet train(std::mt19937& rng, int hiddenUnits = 8, int utterances = 4) {
+// The spectrum alone, 4 bins, one template a class; no networks until asked for.
+TrainingOptions fourBins() {
     TrainingOptions options;
-    options.analysis = AnalysisConfig{};  // the spectrum alone, 4 bins
+    options.analysis = AnalysisConfig{};
     options.analysis.spectrumBins = 4;
     options.clustersPerClass = 1;
     options.jawHiddenUnits = 0;
+    options.classHiddenUnits = 0;
+    return options;
+}
+
+TemplateSet train(std::mt19937& rng, int hiddenUnits = 8, int utterances = 4) {
+    auto options = fourBins();
     options.classHiddenUnits = hiddenUnits;
     options.classEpochs = 20;
     TemplateTrainer trainer(options, PhonemeSet::common());
@@ -184,10 +191,7 @@ TEST(ClassNetwork, TravelsWithTheTemplatesAndIsValidated) {
 TEST(TemplateTrainer, ASegmentLabelledWithConfidenceZeroTeachesNothing) {
     const auto trainWithBilabials = [](float confidence) {
         std::mt19937 rng(7);
-        TrainingOptions options;
-        options.analysis = AnalysisConfig{};
-        options.analysis.spectrumBins = 4;
-        options.clustersPerClass = 1;
+        auto options = fourBins();
         options.jawHiddenUnits = 8;
         options.classHiddenUnits = 8;
         TemplateTrainer trainer(options, PhonemeSet::common());
