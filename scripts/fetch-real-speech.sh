@@ -12,7 +12,8 @@
 # the audio never enters the repository. Labelling needs sox and, for the English word lists,
 # pocketsphinx + pocketsphinx-en-us (a development-time labeller; the product never uses it):
 # `apt-get install sox libsox-fmt-base pocketsphinx pocketsphinx-en-us` (and libsox-fmt-mp3 for
-# the fotaq source).
+# the fotaq source, ffmpeg for the asterisk sources: their prompts are labelled on the 16 kHz
+# G.722 recordings, pocketsphinx's model being a 16 kHz one, and trained on the 8 kHz WAVs).
 # Exit codes: 0 done, 1 error, 2 usage, 77 the packages or tools cannot be had (tests skip).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -20,7 +21,7 @@ out="${1:?usage: fetch-real-speech.sh OUT_DIR [--subset N] [--split train|dev|tu
 shift
 cache="${REAL_SPEECH_CACHE:-$here/build/real-speech-cache}"
 
-split="" mp3=""
+split="" mp3="" g722=""
 for ((i = 1; i <= $#; i++)); do [ "${!i}" = --split ] && { j=$((i + 1)); split="${!j:-}"; }; done
 
 # The packages behind the speakers asked for (config/corpus/real-speakers.txt: SOURCE column).
@@ -29,8 +30,9 @@ while read -r speaker kind source; do
   case "$speaker" in ''|'#'*) continue ;; esac
   [ -n "$split" ] && [ "$kind" != "$split" ] && continue
   case "$source" in
-    asterisk:*) lang="${source##*:}"
-                packages+=("asterisk-core-sounds-$lang-wav" "asterisk-core-sounds-$lang") ;;
+    asterisk:*) lang="${source##*:}" g722=1  # the 16 kHz G.722 recordings are what is labelled
+                packages+=("asterisk-core-sounds-$lang-wav" "asterisk-core-sounds-$lang-g722"
+                           "asterisk-core-sounds-$lang") ;;
     klettres:*) packages+=(klettres-data) ;;
     ktuberling:*) packages+=(ktuberling-data) ;;
     fillets:*) lang="${source#fillets:}" lang="${lang%%:*}"
@@ -52,6 +54,8 @@ for t in "${tools[@]}"; do
 done
 [ -z "$mp3" ] || sox -h 2>/dev/null | grep -q 'FORMATS:.* mp3' ||
   unavailable "sox cannot read MP3 (apt-get install libsox-fmt-mp3), needed by the fotaq source"
+[ -z "$g722" ] || command -v ffmpeg >/dev/null ||
+  unavailable "ffmpeg not found (apt-get install ffmpeg), needed to decode the asterisk prompts' G.722 recordings"
 [ -f /usr/share/pocketsphinx/model/en-us/cmudict-en-us.dict ] ||
   unavailable "the pocketsphinx-en-us model is not installed (apt-get install pocketsphinx-en-us)"
 

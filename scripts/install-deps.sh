@@ -13,6 +13,7 @@ packages=(
   clang libclang-rt-14-dev
   libcpp-httplib-dev chromium chromium-driver
   sox libsox-fmt-base libsox-fmt-mp3 pocketsphinx pocketsphinx-en-us  # labelling real speech (tests, training)
+  ffmpeg  # the asterisk prompts' 16 kHz G.722 recordings, which the labeller aligns
 )
 
 missing=()

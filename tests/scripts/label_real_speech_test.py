@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
 """scripts/label-real-speech.py: the parts that need no package or pocketsphinx (how a label's
-outer edges are moved in over room tone, and how segments are written)."""
+outer edges are moved in over room tone, how segments are written, how a prompt's words are read,
+and which recording of an asterisk prompt is aligned)."""
 import importlib.util
 import math
 import random
+import shutil
 import struct
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -173,6 +176,57 @@ class WriteLab(unittest.TestCase):
         self.assertEqual([r[2] for r in rows], ["sil", "z", "sil"])
         for start, end, _ in rows:
             self.assertLess(start, end)
+
+
+class PromptWords(unittest.TestCase):
+    """An English asterisk prompt's words, as the pronouncing dictionary will spell them."""
+
+    def test_a_digit_is_read_as_its_word(self):
+        # once dropped: "press" was then stretched over "press seven"
+        self.assertEqual(labeller.words_of("Press 7 to delete this message."),
+                         ["press", "seven", "to", "delete", "this", "message"])
+        self.assertEqual(labeller.words_of("3D audio disabled"), ["three", "d", "audio", "disabled"])
+
+    def test_a_longer_number_leaves_the_prompt_out(self):
+        words = labeller.words_of("folder 10")
+        self.assertEqual(labeller.spelling(words, {"folder": [["F", "OW", "L", "D", "ER"]]}), None)
+
+
+@unittest.skipUnless(shutil.which("ffmpeg") and shutil.which("soxi"), "needs ffmpeg and sox")
+class WidebandTwin(unittest.TestCase):
+    """An asterisk prompt is aligned on its 16 kHz G.722 recording, the 8 kHz WAV kept as audio."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = Path(self.tmp.name)
+        self.wav = self.dir / "prompt.wav"
+        write_wav(self.wav, [(0.3, "room"), (0.5, "vowel"), (0.3, "room")])
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def make_twin(self, seconds_more=0.0):
+        wide = self.dir / "wide.wav"
+        write_wav(wide, [(0.3, "room"), (0.5, "vowel"), (0.3 + seconds_more, "room")])
+        subprocess.run(["ffmpeg", "-hide_banner", "-loglevel", "error", "-y", "-i", str(wide),
+                        "-f", "g722", str(self.dir / "prompt.g722")], check=True)
+
+    def test_a_prompt_with_a_g722_twin_is_heard_on_it(self):
+        self.make_twin()
+        heard = labeller.labelling_audio(self.wav, self.wav, 1.1, self.dir)
+        self.assertNotEqual(heard, self.wav)
+        with wave.open(str(heard)) as w:
+            self.assertEqual(w.getframerate(), 16000)
+            self.assertAlmostEqual(w.getnframes() / 16000, 1.1, delta=0.02)
+
+    def test_a_prompt_without_one_is_heard_as_written(self):
+        self.assertEqual(labeller.labelling_audio(self.wav, self.wav, 1.1, self.dir), self.wav)
+
+    def test_a_twin_of_another_length_is_refused_by_name(self):
+        self.make_twin(seconds_more=0.5)
+        with self.assertRaises(SystemExit) as raised:
+            labeller.labelling_audio(self.wav, self.wav, 1.1, self.dir)
+        self.assertIn("prompt.g722 lasts", str(raised.exception))
 
 
 if __name__ == "__main__":
