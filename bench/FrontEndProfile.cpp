@@ -173,6 +173,7 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     distancesOnly.jawNetwork.reset();
     distancesOnly.classNetwork.reset();
     const float classNetworkDb = dsp::ClassifierConfig{}.classNetworkDb;
+    const float classPriorScale = dsp::ClassifierConfig{}.classPriorScale;
     std::vector<int> networkClass;
     std::vector<float> likelihoods, scratch;
     if (templates.classNetwork) {
@@ -243,8 +244,8 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
                 for (std::size_t k = 0; k < count; ++k) {
                     if (!features[k].valid) continue;
                     templates.classNetwork->addToDistances(features[k].spectrum, networkClass,
-                                                           classNetworkDb, distances[k],
-                                                           likelihoods, scratch);
+                                                           classNetworkDb, classPriorScale,
+                                                           distances[k], likelihoods, scratch);
                 }
             });
         if (templates.jawNetwork)

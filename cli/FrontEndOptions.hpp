@@ -58,6 +58,12 @@ struct FrontEndOptions {
                        "templates alone)")
             ->check(CLI::Range(0.0, 20.0))
             ->capture_default_str();
+        cmd.add_option("--class-prior-scale", classifier.classPriorScale,
+                       "With a class network: how much of each class's share of the training "
+                       "frames its posterior is divided by (1: all, the hybrid's scaled "
+                       "likelihood; 0: none, common classes favoured)")
+            ->check(CLI::Range(0.0, 1.0))
+            ->capture_default_str();
         addDecoderTo(cmd);
     }
 

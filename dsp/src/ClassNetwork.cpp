@@ -30,10 +30,11 @@ float logSumExp(std::span<const float> z) {
 // are used, so it is left out: no exponential in the frame loop.
 LIPSYNCD_VECTOR_CLONES void ClassNetwork::scaledLogLikelihoods(std::span<const float> features,
                                                                std::span<float> out,
-                                                               std::span<float> scratch) const {
+                                                               std::span<float> scratch,
+                                                               float priorScale) const {
     network::hiddenSums(hiddenLayer(*this), features, scratch.data());
     const std::size_t count = outputBias.size();
-    for (std::size_t c = 0; c < count; ++c) out[c] = outputBias[c] - logPrior[c];
+    for (std::size_t c = 0; c < count; ++c) out[c] = outputBias[c] - priorScale * logPrior[c];
     for (std::size_t h = 0; h < hiddenBias.size(); ++h) {
         const float a = scratch[h];
         if (!(a > 0)) continue;  // rectified to 0 (or not a number: nothing to add)
@@ -54,9 +55,9 @@ std::vector<int> ClassNetwork::setIndices(const PhonemeSet& set) const {
 }
 
 void ClassNetwork::addToDistances(std::span<const float> features, std::span<const int> setIndices,
-                                  float dbPerNat, std::span<float> distances,
+                                  float dbPerNat, float priorScale, std::span<float> distances,
                                   std::span<float> likelihoods, std::span<float> scratch) const {
-    scaledLogLikelihoods(features, likelihoods, scratch);
+    scaledLogLikelihoods(features, likelihoods, scratch, priorScale);
     const float best = *std::max_element(likelihoods.begin(), likelihoods.end());
     for (std::size_t o = 0; o < likelihoods.size(); ++o) {
         const int c = setIndices[o];

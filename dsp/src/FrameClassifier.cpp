@@ -69,8 +69,8 @@ float FrameClassifier::expectedJaw(float best) const {
 // distances kept for the aligner. Classes the network does not know keep their template distance.
 void FrameClassifier::addClassNetwork(const FrameFeatures& frame) {
     std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
-    classNetwork_->addToDistances(frame.spectrum, networkClass_, config_.classNetworkDb, distances_,
-                                  likelihoods_, hiddenUnits_);
+    classNetwork_->addToDistances(frame.spectrum, networkClass_, config_.classNetworkDb,
+                                  config_.classPriorScale, distances_, likelihoods_, hiddenUnits_);
 }
 
 FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {

@@ -146,6 +146,32 @@ TEST(ClassNetwork, TheAlignerStillWeighsTheTemplatesAlone) {
         }
 }
 
+// ClassifierConfig::classPriorScale: the posteriors are divided by that power of each class's
+// share of the training frames, so at 0 a common class gains on a rare one by the whole ratio of
+// their shares and at 1 by nothing, in the distances the decoder weighs.
+TEST(ClassNetwork, ThePriorScaleDividesOutThatMuchOfEachClassShare) {
+    std::mt19937 rng(5);
+    auto t = train(rng);
+    const auto aa = PhonemeSet::common().find("aa"), ih = PhonemeSet::common().find("ih");
+    ASSERT_TRUE(aa && ih);
+    const std::size_t aaOut = t.classNetwork->classes[0] == "aa" ? 0 : 1;
+    t.classNetwork->logPrior[aaOut] = std::log(0.9f);  // aa common, ih rare
+    t.classNetwork->logPrior[1 - aaOut] = std::log(0.1f);
+    const float ratio = std::log(0.9f / 0.1f);
+    // How much further off ih lies than aa, in dB, on one frame, at a given prior scale.
+    const auto u = utterance(rng, 2);
+    auto ihOverAa = [&](float scale) {
+        ClassifierConfig config;
+        config.classNetworkDb = 1;
+        config.classPriorScale = scale;
+        FrameClassifier c(t, PhonemeSet::common(), config);
+        c.classify(u.frames[3]);
+        return c.distances()[*ih] - c.distances()[*aa];
+    };
+    EXPECT_NEAR(ihOverAa(0) - ihOverAa(1), ratio, 1e-3);
+    EXPECT_NEAR(ihOverAa(0.5f) - ihOverAa(1), ratio / 2, 1e-3);
+}
+
 TEST(ClassNetwork, TravelsWithTheTemplatesAndIsValidated) {
     std::mt19937 rng(3);
     const auto t = train(rng);
