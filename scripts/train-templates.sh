@@ -76,8 +76,8 @@ if [ "$fetch" = 1 ]; then
   [ "$rc" -eq 0 ] || { echo "train-templates.sh: the real training speakers are needed (fetch-real-speech.sh exit $rc)" >&2; exit 1; }
 fi
 
-for folder in "${folders[@]:2}"; do
-  [ -d "$folder" ] || { echo "train-templates.sh: $folder missing: fetch the real speech first (without --no-fetch)" >&2; exit 1; }
+for folder in "${folders[@]}"; do
+  [ "$folder" = "$corpus" ] || [ -d "$folder" ] || { echo "train-templates.sh: $folder missing: fetch the real speech first (without --no-fetch)" >&2; exit 1; }
 done
 
 # Speakers with words but no labels are labelled by the project's own aligner (issue 11: the
