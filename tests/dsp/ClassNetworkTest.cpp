@@ -183,8 +183,8 @@ TEST(ClassNetwork, TravelsWithTheTemplatesAndIsValidated) {
     const auto u = utterance(rng, 2);
     std::vector<float> a(2), b(2), scratch(8);
     for (std::size_t i = 0; i < u.frames.size(); i += 7) {
-        back.classNetwork->scaledLogLikelihoods(u.frames[i].spectrum, a, scratch);
-        t.classNetwork->scaledLogLikelihoods(u.frames[i].spectrum, b, scratch);
+        back.classNetwork->scaledLogLikelihoods(u.frames[i].spectrum, a, scratch, 1.0f);
+        t.classNetwork->scaledLogLikelihoods(u.frames[i].spectrum, b, scratch, 1.0f);
         EXPECT_NEAR(a[0] - a[1], b[0] - b[1], 1e-2);
     }
 

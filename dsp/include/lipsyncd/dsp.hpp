@@ -272,7 +272,7 @@ struct ClassNetwork {
     // at least hiddenUnits() values. No allocation. priorScale 1: the hybrid's scaled
     // likelihoods; 0: the posteriors themselves (ClassifierConfig::classPriorScale).
     void scaledLogLikelihoods(std::span<const float> features, std::span<float> out,
-                              std::span<float> scratch, float priorScale = 1.0f) const;
+                              std::span<float> scratch, float priorScale) const;
     // Per output, its class's index in `set` (-1: not in the set).
     std::vector<int> setIndices(const PhonemeSet& set) const;
     // The hybrid's term added to `distances` (indexed by set index): each class the network
