@@ -117,6 +117,27 @@ void Resample10ms(benchmark::State& state) {
 }
 BENCHMARK(Resample10ms)->Arg(16000)->Arg(44100)->Arg(48000);
 
+// A whole file as analyzeFile reads it: 4096-sample blocks, libsoxr's own DFT block sizes.
+void ResampleFile(benchmark::State& state) {
+    const int rate = static_cast<int>(state.range(0));
+    const auto& audio = speechAt(rate);
+    const auto use = state.range(1) ? dsp::ResamplerUse::WholeFile : dsp::ResamplerUse::Live;
+    dsp::StreamResampler resampler(rate, 10000, dsp::ResamplerQuality::Medium, 4096, use);
+    constexpr std::size_t kBlock = 4096;
+    std::size_t at = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(
+            resampler.process(std::span<const float>(audio).subspan(at, kBlock)).data());
+        at = at + 2 * kBlock < audio.size() ? at + kBlock : 0;
+    }
+    // Per 10 ms analysis frame, as bench/frontend_profile reports its stages.
+    state.counters["per_frame"] =
+        benchmark::Counter(static_cast<double>(state.iterations()) * kBlock / rate * 100,
+                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.counters["delay_ms"] = 1000 * resampler.delaySeconds();
+}
+BENCHMARK(ResampleFile)->ArgsProduct({{16000, 22050, 44100}, {0, 1}});
+
 void Segment(benchmark::State& state) {
     const auto templates = dsp::TemplateSet::loadDefault();
     const auto frames = featuresOf(speechAt(10000), templates.analysis);

@@ -133,7 +133,9 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
 
     // Decode and resample the whole file in the blocks analyzeFile uses.
     auto decoder = dsp::AudioDecoder::open(file);
-    dsp::StreamResampler resampler(decoder.sampleRate(), c.analysisRate);
+    dsp::StreamResampler resampler(decoder.sampleRate(), c.analysisRate,
+                                   dsp::ResamplerQuality::Medium, 4096,
+                                   dsp::ResamplerUse::WholeFile);
     std::vector<float> block(4096), resampled;
     for (;;) {
         std::size_t n = 0;

@@ -254,7 +254,9 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     const auto start = speaker ? speaker->adaptedIfHeard(alignerConfig.speakerAdaptationPriorFrames)
                                : std::nullopt;
     const TemplateSet& first = start ? *start : base;
-    StreamingAnalyzer analyzer(first, set, decoder.sampleRate(), config);
+    auto wholeFile = config;
+    wholeFile.resamplerUse = ResamplerUse::WholeFile;
+    StreamingAnalyzer analyzer(first, set, decoder.sampleRate(), wholeFile);
     ForcedAligner aligner(script, set, first.analysis.hopSeconds, r.timeScale, alignerConfig);
     // The frames expected (the analyser's count can differ by its edge frames).
     const auto expected = std::llround(timing.durationSeconds / first.analysis.hopSeconds);

@@ -10,8 +10,9 @@ namespace {
 constexpr std::size_t kMaxInputBlock = 4096;
 }
 
-FrameStream::FrameStream(const AnalysisConfig& config, double inputRate, ResamplerQuality quality)
-    : resampler_(inputRate, config.analysisRate, quality, kMaxInputBlock), analyzer_(config) {
+FrameStream::FrameStream(const AnalysisConfig& config, double inputRate, ResamplerQuality quality,
+                         ResamplerUse use)
+    : resampler_(inputRate, config.analysisRate, quality, kMaxInputBlock, use), analyzer_(config) {
     features_ = analyzer_.makeFeatures();
     const auto window = static_cast<std::size_t>(config.windowSamples());
     const auto maxOut = static_cast<std::size_t>(
@@ -84,7 +85,8 @@ std::vector<FrameFeatures> analyzeFrames(const std::filesystem::path& file,
                                          const AnalysisConfig& config,
                                          const DecodeOptions& decode) {
     auto decoder = AudioDecoder::open(file, decode);
-    FrameStream stream(config, decoder.sampleRate());
+    FrameStream stream(config, decoder.sampleRate(), ResamplerQuality::Medium,
+                       ResamplerUse::WholeFile);
     std::vector<FrameFeatures> frames;
     const FrameStream::Sink keep = [&](const FrameFeatures& f) { frames.push_back(f); };
     std::vector<float> block(kMaxInputBlock);

@@ -18,15 +18,16 @@ struct StreamResampler::State {
 };
 
 namespace {
-soxr_t createSoxr(double inputRate, double outputRate, ResamplerQuality quality);
+soxr_t createSoxr(double inputRate, double outputRate, ResamplerQuality quality, ResamplerUse use);
 
 // Feeds silence in 10 ms blocks through a fresh resampler and returns the longest any sample
 // waited: when a call releases output, its first new sample went in at input time `made` and
 // comes out once `fed` seconds of input are in. Steady state only (after a warm-up second: the
 // start-up fill happens once, before any sound a live path waits for). Run once at setup, so
 // process() stays allocation-free.
-double measureHeldBack(double inputRate, double outputRate, ResamplerQuality quality) {
-    soxr_t probe = createSoxr(inputRate, outputRate, quality);
+double measureHeldBack(double inputRate, double outputRate, ResamplerQuality quality,
+                       ResamplerUse use) {
+    soxr_t probe = createSoxr(inputRate, outputRate, quality, use);
     const auto block = static_cast<std::size_t>(std::max(1.0, std::round(inputRate / 100)));
     std::vector<float> in(block, 0.0f);
     std::vector<float> out(static_cast<std::size_t>(std::ceil(block * outputRate / inputRate)) +
@@ -59,16 +60,20 @@ unsigned long soxrRecipe(ResamplerQuality q) {
     return SOXR_MQ;
 }
 
-soxr_t createSoxr(double inputRate, double outputRate, ResamplerQuality quality) {
+soxr_t createSoxr(double inputRate, double outputRate, ResamplerQuality quality, ResamplerUse use) {
     soxr_error_t err = nullptr;
     const auto io = soxr_io_spec(SOXR_FLOAT32_I, SOXR_FLOAT32_I);
     const auto q = soxr_quality_spec(soxrRecipe(quality), 0);
-    // Smaller DFT blocks: libsoxr's defaults (2^10 .. 2^17) hold back up to 94 ms of 16 kHz
-    // input at MQ; 2^8 .. 2^10 hold back 43 ms (MQ) or 22 ms (LQ, minimum phase) at the same
-    // speed (measured with 10 ms blocks; bench/frontend_bench Resample10ms reports delay_ms).
     auto runtime = soxr_runtime_spec(1);
-    runtime.log2_min_dft_size = 8;
-    runtime.log2_large_dft_size = 10;
+    // Live: smaller DFT blocks. libsoxr's defaults (2^10 .. 2^17) hold back up to 94 ms of
+    // 16 kHz input at MQ; 2^8 .. 2^10 hold back 43 ms (MQ) or 22 ms (LQ, minimum phase), at the
+    // same speed in 10 ms blocks (bench/frontend_bench Resample10ms reports delay_ms). A whole
+    // file keeps the defaults: in 4096-sample blocks they are 1.1-1.8 times faster
+    // (bench/frontend_bench ResampleFile).
+    if (use == ResamplerUse::Live) {
+        runtime.log2_min_dft_size = 8;
+        runtime.log2_large_dft_size = 10;
+    }
     soxr_t soxr = soxr_create(inputRate, outputRate, 1, &err, &io, &q, &runtime);
     if (err) throw std::runtime_error(std::string("libsoxr: ") + err);
     return soxr;
@@ -76,12 +81,12 @@ soxr_t createSoxr(double inputRate, double outputRate, ResamplerQuality quality)
 }  // namespace
 
 StreamResampler::StreamResampler(double inputRate, double outputRate, ResamplerQuality quality,
-                                 std::size_t maxBlock)
+                                 std::size_t maxBlock, ResamplerUse use)
     : state_(std::make_unique<State>()), inputRate_(inputRate), outputRate_(outputRate) {
     if (!(inputRate > 0) || !(outputRate > 0))
         throw InputError("resampler: rates must be positive");
-    state_->soxr = createSoxr(inputRate, outputRate, quality);
-    delaySeconds_ = measureHeldBack(inputRate, outputRate, quality);
+    state_->soxr = createSoxr(inputRate, outputRate, quality, use);
+    delaySeconds_ = measureHeldBack(inputRate, outputRate, quality, use);
     state_->maxBlock = maxBlock;
     // Room for one block's worth of output plus what the filter may release on flush.
     const auto room = static_cast<std::size_t>(std::ceil(maxBlock * outputRate / inputRate)) + 4096;

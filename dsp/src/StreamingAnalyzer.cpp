@@ -20,7 +20,7 @@ StreamingAnalyzer::StreamingAnalyzer(const TemplateSet& templates, const Phoneme
                                      double inputRate, const FrontEndConfig& config)
     : templates_(templates),
       config_(withTemplateAnalysis(config, templates)),
-      frames_(config_.analysis, inputRate, config_.resamplerQuality),
+      frames_(config_.analysis, inputRate, config_.resamplerQuality, config_.resamplerUse),
       classifier_(templates_, set, config_.classifier),
       segmenter_(set, config_.analysis.hopSeconds, config_.segmenter) {
     if (config_.decoder.enabled)
@@ -70,7 +70,9 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     auto decoder = AudioDecoder::open(file, decode, raw);
     AnalysisResult result;
     result.inputRate = decoder.sampleRate();
-    StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), config);
+    auto wholeFile = config;
+    wholeFile.resamplerUse = ResamplerUse::WholeFile;
+    StreamingAnalyzer analyzer(templates, set, decoder.sampleRate(), wholeFile);
     // One level a frame is all that grows with the input (besides the schedule): reserved at
     // once when the length is known, so an hour does not pass through doubling copies.
     if (const auto frames = decoder.frames()) {

@@ -9,6 +9,15 @@
 
 namespace lipsyncd::dsp {
 
+namespace {
+// ‖x‖², its terms summed in order.
+float squaredNorm(std::span<const float> x) {
+    float sum = 0;
+    for (const float v : x) sum += v * v;
+    return sum;
+}
+}  // namespace
+
 FeatureWeighting::FeatureWeighting(const TemplateSet& templates)
     : features_(templates.binWeights.size()) {
     scale_.resize(features_);
@@ -45,6 +54,7 @@ TemplateMatrix::TemplateMatrix(const TemplateSet& templates, const PhonemeSet& s
                 transform(c.spectra[std::min(first + lane, c.spectra.size() - 1)], stored);
                 for (std::size_t b = 0; b < features; ++b)
                     blocks_[at + b * kLanes + lane] = stored[b];
+                norms_.push_back(squaredNorm(stored));
             }
             blockClass_.push_back(static_cast<int>(*idx));
         }
@@ -70,76 +80,131 @@ float leastLane(const Lanes& v) {
     return m;
 }
 
-// Squared distances from x to the eight templates of one block. Feature f goes into partial
-// sum f mod 8, as in a row loop of eight partial sums.
-LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, std::size_t features,
-                                            const float* blocks, const int* blockClass,
-                                            std::size_t blockCount, BlockRecord record,
-                                            float* out) {
-    const std::size_t stride = features * TemplateMatrix::kLanes;
-    const std::size_t whole = features / 8 * 8;
-    for (std::size_t block = 0; block < blockCount;) {
-        const int cls = blockClass[block];
-        Lanes best;
-        for (std::size_t lane = 0; lane < TemplateMatrix::kLanes; ++lane)
-            best[lane] = std::numeric_limits<float>::infinity();
-        float known = std::numeric_limits<float>::infinity();
-        for (; block < blockCount && blockClass[block] == cls; ++block) {
-            if (record.known && record.known[block]) {
-                known = std::min(known, record.values[block]);
-                continue;
-            }
-            const float* t = blocks + block * stride;
-            Lanes acc[8] = {};
-            std::size_t f = 0;
-            for (; f < whole; f += 8)
-#pragma GCC unroll 8
-                for (std::size_t k = 0; k < 8; ++k) {
-                    Lanes row;
-                    std::memcpy(&row, t + (f + k) * TemplateMatrix::kLanes, sizeof row);
-                    const Lanes d = x[f + k] - row;
-                    acc[k] += d * d;
-                }
-#pragma GCC unroll 8
-            for (std::size_t k = 0; k < 8; ++k)
-                if (f + k < features) {
-                    Lanes row;
-                    std::memcpy(&row, t + (f + k) * TemplateMatrix::kLanes, sizeof row);
-                    const Lanes d = x[f + k] - row;
-                    acc[k] += d * d;
-                }
-            const Lanes sum =
-                ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-            best = sum < best ? sum : best;
-            if (record.write) record.write[block] = leastLane(sum);
+// Squared distances from x to the templates of N adjacent blocks, as ‖x‖² + (‖t‖² − 2·x·t): a
+// multiply and an add per feature and template, where (x − t)² took a subtract as well. The loop
+// is bound by its loads, so N blocks share each broadcast of x[f] (N = 4: 5 loads per 4 block
+// features, not 8). Each template's dot product is formed the same way for any N: feature f into
+// partial sum f mod 2, the two added last. The norms are a few thousand and the distances that
+// decide a class a few hundred, so the rounding this adds is about 1e-3 of a squared dB.
+template <std::size_t N>
+[[gnu::always_inline]] inline void blockDistances(const float* x, float xNorm, std::size_t features,
+                                                  const float* t, const float* norms, Lanes* sums) {
+    constexpr std::size_t kStride = TemplateMatrix::kLanes;
+    const std::size_t blockStride = features * kStride;
+    Lanes even[N] = {}, odd[N] = {};
+    auto add = [&](Lanes* acc, std::size_t f) {
+        const float xf = x[f];
+#pragma GCC unroll 4
+        for (std::size_t b = 0; b < N; ++b) {
+            Lanes row;
+            std::memcpy(&row, t + b * blockStride + f * kStride, sizeof row);
+            acc[b] += xf * row;
         }
-        float m = best[0];
-        for (std::size_t lane = 1; lane < TemplateMatrix::kLanes; ++lane)
-            m = std::min(m, best[lane]);
-        out[cls] = std::min(m, known);
+    };
+    std::size_t f = 0;
+    for (; f + 1 < features; f += 2) {
+        add(even, f);
+        add(odd, f + 1);
     }
+    if (f < features) add(even, f);
+#pragma GCC unroll 4
+    for (std::size_t b = 0; b < N; ++b) {
+        Lanes norm;
+        std::memcpy(&norm, norms + b * kStride, sizeof norm);
+        const Lanes dot = even[b] + odd[b];
+        sums[b] = (norm - (dot + dot)) + xNorm;
+    }
+}
+
+// The running minimum of each class over its blocks (a class's blocks are adjacent), written to
+// `out` when the next class starts.
+class ClassMinimum {
+  public:
+    explicit ClassMinimum(float* out) : out_(out) {}
+    void add(int cls, const Lanes& sums) {
+        start(cls);
+        best_ = sums < best_ ? sums : best_;
+    }
+    void addKnown(int cls, float least) {
+        start(cls);
+        known_ = std::min(known_, least);
+    }
+    void finish() {
+        if (cls_ < 0) return;
+        // Rounding can take a distance of (almost) zero just below it.
+        out_[cls_] = std::max(0.0f, std::min(leastLane(best_), known_));
+    }
+
+  private:
+    void start(int cls) {
+        if (cls == cls_) return;
+        finish();
+        cls_ = cls;
+        for (std::size_t lane = 0; lane < TemplateMatrix::kLanes; ++lane)
+            best_[lane] = std::numeric_limits<float>::infinity();
+        known_ = std::numeric_limits<float>::infinity();
+    }
+    float* out_;
+    int cls_ = -1;
+    Lanes best_{};
+    float known_ = 0;
+};
+
+LIPSYNCD_VECTOR_CLONES void nearestPerClass(const float* x, float xNorm, std::size_t features,
+                                            const float* blocks, const float* norms,
+                                            const int* blockClass, std::size_t blockCount,
+                                            BlockRecord record, float* out) {
+    constexpr std::size_t kGroup = 4;
+    const std::size_t stride = features * TemplateMatrix::kLanes;
+    auto known = [&](std::size_t block) { return record.known && record.known[block]; };
+    ClassMinimum minimum(out);
+    for (std::size_t block = 0; block < blockCount;) {
+        if (known(block)) {
+            minimum.addKnown(blockClass[block], record.values[block]);
+            ++block;
+            continue;
+        }
+        std::size_t n = 1;
+        if (block + kGroup <= blockCount && !known(block + 1) && !known(block + 2) &&
+            !known(block + 3))
+            n = kGroup;
+        Lanes sums[kGroup];
+        const float* t = blocks + block * stride;
+        const float* norm = norms + block * TemplateMatrix::kLanes;
+        if (n == kGroup)
+            blockDistances<kGroup>(x, xNorm, features, t, norm, sums);
+        else
+            blockDistances<1>(x, xNorm, features, t, norm, sums);
+        for (std::size_t i = 0; i < n; ++i, ++block) {
+            if (record.write) record.write[block] = leastLane(sums[i]);
+            minimum.add(blockClass[block], sums[i]);
+        }
+    }
+    minimum.finish();
 }
 }  // namespace
 
 void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out) const {
     std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
-    nearestPerClass(scaledFrame.data(), features(), blocks_.data(), blockClass_.data(),
-                    blockClass_.size(), {}, out.data());
+    nearestPerClass(scaledFrame.data(), squaredNorm(scaledFrame), features(), blocks_.data(),
+                    norms_.data(), blockClass_.data(), blockClass_.size(), {}, out.data());
 }
 
 void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out,
                              std::span<float> record) const {
     std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
-    nearestPerClass(scaledFrame.data(), features(), blocks_.data(), blockClass_.data(),
-                    blockClass_.size(), {record.data()}, out.data());
+    nearestPerClass(scaledFrame.data(), squaredNorm(scaledFrame), features(), blocks_.data(),
+                    norms_.data(), blockClass_.data(), blockClass_.size(), {record.data()},
+                    out.data());
 }
 
 void TemplateMatrix::nearest(std::span<const float> scaledFrame, std::span<float> out,
                              std::span<const std::uint8_t> same,
                              std::span<const float> record) const {
     std::fill(out.begin(), out.end(), std::numeric_limits<float>::infinity());
-    nearestPerClass(scaledFrame.data(), features(), blocks_.data(), blockClass_.data(),
-                    blockClass_.size(), {nullptr, same.data(), record.data()}, out.data());
+    nearestPerClass(scaledFrame.data(), squaredNorm(scaledFrame), features(), blocks_.data(),
+                    norms_.data(), blockClass_.data(), blockClass_.size(),
+                    {nullptr, same.data(), record.data()}, out.data());
 }
 
 std::vector<std::uint8_t> TemplateMatrix::sameBlocks(const TemplateMatrix& other) const {

@@ -5,9 +5,11 @@
 // template, which cannot change a minimum), each block feature-major ([feature][8 templates]), so
 // that one vector operation serves eight templates and no per-template horizontal sum is needed.
 //
-// Each template's sum is formed exactly as a row-by-row loop with eight partial sums forms it
-// (feature f into partial sum f mod 8, in order; the partial sums added as
-// ((0+4)+(1+5))+((2+6)+(3+7))), so the distances do not depend on the layout.
+// A distance is taken as ‖x‖² + ‖t‖² − 2·x·t, each template's norm stored beside its block: a
+// multiply and an add per feature and template, and four blocks share each load of the frame's
+// feature. Each template's dot product is formed in the same order whatever block it sits in
+// (feature f into partial sum f mod 2, the two added last), so the distances do not depend on the
+// layout.
 //
 // A second pass over the same frames on a set where only some templates moved (SpeakerAdaptation)
 // need not measure the blocks that did not: the first pass records each block's least distance,
@@ -72,6 +74,7 @@ class TemplateMatrix {
   private:
     FeatureWeighting weighting_;
     std::vector<float> blocks_;    // [block][feature][lane]
+    std::vector<float> norms_;     // [block][lane]: each stored template's ‖t‖²
     std::vector<int> blockClass_;  // phoneme set index of each block (blocks of a class adjacent)
 };
 

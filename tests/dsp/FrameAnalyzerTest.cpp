@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <lipsyncd/dsp.hpp>
 #include <numbers>
 #include <random>
@@ -63,6 +64,37 @@ TEST(LpcSpectrum, DirectAndFftEvaluationAgree) {
         fft.evaluate(a, f);
         for (int m = 0; m < 32; ++m) EXPECT_NEAR(d[m], f[m], 1e-3) << m;
     }
+}
+
+// The envelope's levels are taken eight bins at a time by a series, not libm's log10f: they must
+// still be −10·log10 |A(e^jω)|² to well under the spectra's own precision, in every bin of a grid
+// that is not a multiple of eight, up to the +100 dB cap at a pole on the unit circle.
+TEST(LpcSpectrum, LevelsAreTheEnvelopeInDbToAHundredthOfAMillibel) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-0.9f, 0.9f);
+    for (const int bins : {32, 20}) {
+        DirectLpcSpectrum direct(12, bins);
+        std::vector<float> a(13), db(static_cast<std::size_t>(bins));
+        for (int trial = 0; trial < 50; ++trial) {
+            a[0] = 1;
+            for (int i = 1; i < 13; ++i) a[i] = u(rng) * static_cast<float>(trial % 5 + 1) / i;
+            direct.evaluate(a, db);
+            for (int m = 0; m < bins; ++m) {
+                std::complex<double> sum = 0;
+                for (int i = 0; i < 13; ++i)
+                    sum += static_cast<double>(a[i]) *
+                           std::polar(1.0, -std::numbers::pi * m * i / bins);
+                const double want = -10 * std::log10(std::max(std::norm(sum), 1e-10));
+                EXPECT_NEAR(db[m], want, 1e-3 + 1e-5 * std::abs(want))
+                    << bins << " bins, bin " << m;
+            }
+        }
+    }
+    // A zero of A on the grid (a = 1, −1: ω = 0) is the cap, not infinity.
+    DirectLpcSpectrum two(1, 8);
+    std::vector<float> db(8);
+    two.evaluate(std::vector<float>{1.0f, -1.0f}, db);
+    EXPECT_NEAR(db[0], 100.0f, 1e-3);
 }
 
 // A warp reads the envelope at warp times each bin's frequency: a resonance at f shows in the

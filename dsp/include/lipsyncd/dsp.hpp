@@ -89,12 +89,16 @@ void writeWavFile(const std::filesystem::path& file, std::span<const float> samp
                   int sampleRate);
 
 enum class ResamplerQuality { Low, Medium, High, VeryHigh };
+// What the resampler's output waits for. Live input wants little held back (libsoxr's DFT blocks
+// kept small); a whole file does not wait for anyone, and libsoxr's default blocks resample it
+// up to 1.8 times faster with the same filter (outputs differ by rounding, about 2e-7).
+enum class ResamplerUse { Live, WholeFile };
 
 class StreamResampler {
   public:
     StreamResampler(double inputRate, double outputRate,
                     ResamplerQuality quality = ResamplerQuality::Medium,
-                    std::size_t maxBlock = 4096);
+                    std::size_t maxBlock = 4096, ResamplerUse use = ResamplerUse::Live);
     StreamResampler(StreamResampler&&) noexcept;
     StreamResampler& operator=(StreamResampler&&) noexcept;
     ~StreamResampler();
@@ -547,6 +551,7 @@ struct FrontEndConfig {
     DecoderConfig decoder;
     std::optional<TransitionModel> transitions;  // decoder.enabled and unset: loadDefault()
     ResamplerQuality resamplerQuality = ResamplerQuality::Medium;
+    ResamplerUse resamplerUse = ResamplerUse::Live;  // analyzeFile and alignFile: WholeFile
 };
 
 // Resampling and framing: samples at any rate in, analysed frames (features) out, every hop.
@@ -554,7 +559,8 @@ class FrameStream {
   public:
     using Sink = std::function<void(const FrameFeatures&)>;
     FrameStream(const AnalysisConfig& config, double inputRate,
-                ResamplerQuality quality = ResamplerQuality::Medium);
+                ResamplerQuality quality = ResamplerQuality::Medium,
+                ResamplerUse use = ResamplerUse::Live);
     // Any block size; `sink` is called for every frame completed.
     void push(std::span<const float> samples, const Sink& sink);
     // Drains the resampler and analyses the frames centred inside the audio.
