@@ -116,8 +116,8 @@ template <std::size_t N>
     }
 }
 
-// The running minimum of each class over its blocks (a class's blocks are adjacent), written to
-// `out` when the next class starts.
+// The running minimum of each class over its blocks (a class's blocks are adjacent), taken into
+// `out` (which starts at +inf) when the next class starts.
 class ClassMinimum {
   public:
     explicit ClassMinimum(float* out) : out_(out) {}
@@ -132,7 +132,8 @@ class ClassMinimum {
     void finish() {
         if (cls_ < 0) return;
         // Rounding can take a distance of (almost) zero just below it.
-        out_[cls_] = std::max(0.0f, std::min(leastLane(best_), known_));
+        const float least = std::max(0.0f, std::min(leastLane(best_), known_));
+        out_[cls_] = std::min(out_[cls_], least);
     }
 
   private:
