@@ -91,7 +91,7 @@ void writeWavFile(const std::filesystem::path& file, std::span<const float> samp
 enum class ResamplerQuality { Low, Medium, High, VeryHigh };
 // What the resampler's output waits for. Live input wants little held back (libsoxr's DFT blocks
 // kept small); a whole file does not wait for anyone, and libsoxr's default blocks resample it
-// up to 1.8 times faster with the same filter (outputs differ by rounding, about 2e-7).
+// about 1.35 times faster with the same filter (outputs differ by rounding, about 2e-7).
 enum class ResamplerUse { Live, WholeFile };
 
 class StreamResampler {
