@@ -41,23 +41,24 @@ float toDb(float re, float im) {
     db = (-10.0f / std::numbers::ln10_v<float>)*ln;
 }
 
-// The bins' levels in dB: the vector form for every bin, then libm's for any bin whose power is
-// not finite (NaN or overflow), as it treats those.
+// The bins' levels in dB: the vector form, but libm's for a bin whose power is not finite (NaN or
+// overflow), as it treats those.
 LIPSYNCD_VECTOR_CLONES void binsToDb(const float* re, const float* im, int bins, float* outDb) {
     const auto n = static_cast<std::size_t>(bins);
     for (std::size_t first = 0; first < n; first += kVectorLanes) {
-        FloatLanes p;
+        FloatLanes power, p;
         for (std::size_t l = 0; l < kVectorLanes; ++l) {
             const std::size_t m = std::min(first + l, n - 1);
-            const float power = re[m] * re[m] + im[m] * im[m];
-            p[l] = std::min(std::max(power, kMinPower), std::numeric_limits<float>::max());
+            power[l] = re[m] * re[m] + im[m] * im[m];
+            p[l] = std::min(std::max(power[l], kMinPower), std::numeric_limits<float>::max());
         }
         FloatLanes db;
         powerToDb(p, db);
-        for (std::size_t l = 0; l < kVectorLanes && first + l < n; ++l) outDb[first + l] = db[l];
+        for (std::size_t l = 0; l < kVectorLanes && first + l < n; ++l) {
+            const std::size_t m = first + l;
+            outDb[m] = std::isfinite(power[l]) ? db[l] : toDb(re[m], im[m]);
+        }
     }
-    for (std::size_t m = 0; m < n; ++m)
-        if (!std::isfinite(re[m] * re[m] + im[m] * im[m])) outDb[m] = toDb(re[m], im[m]);
 }
 }  // namespace
 
