@@ -2,9 +2,11 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <lipsyncd/dsp.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace lipsyncd::cli {
 
@@ -17,6 +19,8 @@ struct FrontEndOptions {
     dsp::DecoderConfig decoder;
     std::string transitions;  // empty: the shipped default
     dsp::ClassifierConfig classifier;
+    std::vector<std::string> classBias;  // CLASS=DB, over the set's class_bias_db
+    bool noClassBias = false;
 
     void addTo(CLI::App& cmd) {
         cmd.add_option("--templates", templates,
@@ -64,6 +68,11 @@ struct FrontEndOptions {
                        "likelihood; 0: none, common classes favoured)")
             ->check(CLI::Range(0.0, 1.0))
             ->capture_default_str();
+        cmd.add_option("--class-bias", classBias,
+                       "dB added to a class's distance, CLASS=DB (repeatable; over the template "
+                       "set's class_bias_db, a negative value favours the class)");
+        cmd.add_flag("--no-class-bias", noClassBias,
+                     "Leave out the template set's class bias (class_bias_db)");
         addDecoderTo(cmd);
     }
 
@@ -84,7 +93,21 @@ struct FrontEndOptions {
                        "config/decoder/english-transitions.json)");
     }
 
-    dsp::TemplateSet loadTemplates() const { return dsp::TemplateSet::named(templates); }
+    dsp::TemplateSet loadTemplates() const {
+        auto set = dsp::TemplateSet::named(templates);
+        if (noClassBias) set.classBiasDb.clear();
+        for (const auto& item : classBias) {
+            const auto eq = item.find('=');
+            char* end = nullptr;
+            const float db =
+                eq == std::string::npos ? 0.0f : std::strtof(item.c_str() + eq + 1, &end);
+            if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
+                throw InputError("--class-bias: '" + item + "' is not CLASS=DB (e.g. bmp=0.3)");
+            set.classBiasDb[item.substr(0, eq)] = db;
+        }
+        if (!classBias.empty()) set.validate("--class-bias");
+        return set;
+    }
     dsp::DecodeOptions decode() const { return {channel}; }
     std::optional<dsp::RawFormat> raw() const {
         if (rawSpec.empty()) return std::nullopt;

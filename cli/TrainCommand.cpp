@@ -86,7 +86,14 @@ void runTrain(TrainOptions o) {
         if (o.training.classHiddenUnits > 0 && !templates.classNetwork)
             throw InputError("--keep-templates: too little labelled speech for the class network");
         if (o.training.jawHiddenUnits > 0) kept->jawNetwork = std::move(templates.jawNetwork);
-        if (o.training.classHiddenUnits > 0) kept->classNetwork = std::move(templates.classNetwork);
+        if (o.training.classHiddenUnits > 0) {
+            kept->classNetwork = std::move(templates.classNetwork);
+            // The bias corrected the old network's priors; a new network needs its own fit.
+            if (!kept->classBiasDb.empty())
+                std::cerr << "lipsync train: dropped the set's class_bias_db (fitted for its old "
+                             "class network; scripts/fit-class-bias.py fits one)\n";
+            kept->classBiasDb.clear();
+        }
         if (!o.description.empty()) kept->description = o.description;
         templates = std::move(*kept);
     }

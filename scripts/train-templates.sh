@@ -24,6 +24,10 @@
 # The networks (the jaw and the class heard from each frame: config/templates/README.md) are
 # trained on the same speech, with `lipsync train --keep-templates`, which leaves the templates
 # as they are.
+# The set it writes has no class bias (class_bias_db); the shipped one's is fitted afterwards on
+# the tune voices, which no set is trained on:
+#   scripts/fit-class-bias.py --set config/templates/default.json \
+#       --corpus build/real-speech/tune --write
 set -euo pipefail
 usage() {
   echo "usage: scripts/train-templates.sh [--networks-only | --channel-normalised]" \

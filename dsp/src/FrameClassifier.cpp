@@ -29,6 +29,12 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
         hiddenUnits_.assign(classNetwork_->hiddenUnits(), 0.0f);
         templateDistances_.assign(set.size(), std::numeric_limits<float>::infinity());
     }
+    if (!templates.classBiasDb.empty()) {
+        classBias_.assign(set.size(), 0.0f);
+        for (const auto& [name, db] : templates.classBiasDb)
+            if (const auto i = set.find(name)) classBias_[*i] = db;
+        templateDistances_.assign(set.size(), std::numeric_limits<float>::infinity());
+    }
     matrix_ = std::make_shared<const TemplateMatrix>(templates, set);
     scaledFrame_.assign(matrix_->features(), 0.0f);
     distances_.assign(set.size(), std::numeric_limits<float>::infinity());
@@ -71,6 +77,13 @@ void FrameClassifier::addClassNetwork(const FrameFeatures& frame) {
     std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
     classNetwork_->addToDistances(frame.spectrum, networkClass_, config_.classNetworkDb,
                                   config_.classPriorScale, distances_, likelihoods_, hiddenUnits_);
+}
+
+// The set's per-class correction (TemplateSet::classBiasDb), after the network's term; the
+// templates' own distances are kept for the aligner, as addClassNetwork keeps them.
+void FrameClassifier::addClassBias() {
+    if (!classNetwork_) std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
+    for (std::size_t c = 0; c < distances_.size(); ++c) distances_[c] += classBias_[c];
 }
 
 FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
@@ -123,6 +136,7 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
     matrix_->toRms(distances_);  // weighted RMS difference, in dB
 
     if (classNetwork_) addClassNetwork(frame);
+    if (!classBias_.empty()) addClassBias();
 
     const int sil = sil_;
     int first = -1, second = -1;

@@ -208,6 +208,14 @@ void TemplateSet::validate(const std::string& source) const {
                 throw InputError(source, 0, where + ": '" + names[c] + "' listed twice");
         }
     }
+    // Within ±20 dB: a fitted correction moves a class by a dB or so; more is a broken file.
+    for (const auto& [name, db] : classBiasDb) {
+        const std::string where = "class_bias_db." + name;
+        if (!set.find(name))
+            throw InputError(source, 0, where + ": '" + name + "' is not a phoneme class");
+        if (!std::isfinite(db) || std::abs(db) > 20)
+            throw InputError(source, 0, where + ": must be a finite dB within ±20");
+    }
     for (std::size_t c = 0; c < classes.size(); ++c) {
         const auto& cls = classes[c];
         const std::string where = "classes[" + std::to_string(c) + "] ('" + cls.phoneme + "')";
@@ -245,6 +253,8 @@ TemplateSet TemplateSet::load(const std::filesystem::path& file) {
         t.jawNetwork = readJawNetwork(member<json>(j, "jaw_network", "", source), source);
     if (j.contains("class_network"))
         t.classNetwork = readClassNetwork(member<json>(j, "class_network", "", source), source);
+    if (j.contains("class_bias_db"))
+        t.classBiasDb = member<std::map<std::string, float>>(j, "class_bias_db", "", source);
     const auto classes = member<json>(j, "classes", "", source);
     if (!classes.is_array()) throw InputError(source, 0, "field 'classes' must be an array");
     for (std::size_t i = 0; i < classes.size(); ++i) {
@@ -289,6 +299,12 @@ void TemplateSet::save(const std::filesystem::path& file) const {
     }
     if (jawNetwork) j["jaw_network"] = writeJawNetwork(*jawNetwork);
     if (classNetwork) j["class_network"] = writeClassNetwork(*classNetwork);
+    if (!classBiasDb.empty()) {
+        json bias = json::object();
+        for (const auto& [name, db] : classBiasDb)
+            bias[name] = std::round(static_cast<double>(db) * 1000) / 1000;  // to 1/1000 dB
+        j["class_bias_db"] = bias;
+    }
     std::ofstream out(file);
     if (!out) throw InputError(file.string() + ": cannot write");
     out << j.dump(1) << '\n';

@@ -93,6 +93,35 @@ TEST(LipsyncCli, AnalyzeWritesAScheduleThatReadsBack) {
     EXPECT_NE(header.find("runner_up"), std::string::npos) << header;
 }
 
+// --class-bias CLASS=DB moves a class's distance (over the set's class_bias_db): enough dB on
+// the bilabials and the schedule has none. A malformed one is named.
+TEST(LipsyncCli, AnalyzeTakesAClassBiasAndNamesABadOne) {
+    const auto dir = scratchDir("cli_class_bias");
+    const auto countBilabials = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = {"analyze", exampleWav().string(), "-s",
+                                         (dir / "s.tsv").string(), "-q"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const auto r = runLipsync(args);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        const auto schedule = readScheduleFile(dir / "s.tsv");
+        return std::count_if(schedule.begin(), schedule.end(),
+                             [](const auto& p) { return p.phoneme == "bmp"; });
+    };
+    EXPECT_GT(countBilabials({}), 0);  // "puppet"
+    EXPECT_EQ(countBilabials({"--class-bias", "bmp=19"}), 0);
+    EXPECT_GT(countBilabials({"--class-bias", "bmp=19", "--class-bias", "bmp=0"}), 0);
+    for (const auto& [bad, says] : std::vector<std::pair<std::string, std::string>>{
+             {"bmp", "--class-bias: 'bmp' is not CLASS=DB"},
+             {"bmp=x", "--class-bias: 'bmp=x' is not CLASS=DB"},
+             {"xx=1", "class_bias_db.xx: 'xx' is not a phoneme class"},
+             {"bmp=30", "class_bias_db.bmp: must be a finite dB within ±20"}}) {
+        const auto r = runLipsync({"analyze", exampleWav().string(), "-s", (dir / "s.tsv").string(),
+                                   "--class-bias", bad});
+        EXPECT_EQ(r.exitCode, 1) << bad;
+        EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    }
+}
+
 // --features: every frame's feature vector, as the templates and the jaw network see it, with
 // the class decided and the heard jaw (what a training experiment starts from).
 TEST(LipsyncCli, AnalyzeWritesEachFramesFeatures) {

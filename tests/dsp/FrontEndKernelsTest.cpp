@@ -20,7 +20,8 @@ namespace {
 const dsp::TemplateSet& templates() {
     static const auto t = [] {
         auto set = dsp::TemplateSet::loadDefault();
-        set.classNetwork.reset();
+        set.classNetwork.reset();  // the templates' distances alone: neither the network's term
+        set.classBiasDb.clear();   // nor the class bias
         return set;
     }();
     return t;

@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <functional>
 #include <lipsyncd/core.hpp>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -312,6 +313,12 @@ struct TemplateSet {
     std::optional<JawNetwork> jawNetwork;
     // Optional: scaled class likelihoods added to the distances (ClassifierConfig::classNetworkDb).
     std::optional<ClassNetwork> classNetwork;
+    // Optional: dB added to a class's distance (after the class network's term), per class name:
+    // a correction of the classes' priors for real voices, which the training speech (mostly
+    // espeak-ng) does not give. Fitted on voices held out of training by
+    // scripts/fit-class-bias.py; the forced aligner, whose classes the words give, weighs the
+    // templates' distances without it.
+    std::map<std::string, float> classBiasDb;
     std::string description;
 
     static TemplateSet load(const std::filesystem::path& file);  // validates; InputError
@@ -387,15 +394,16 @@ class FrameClassifier {
     FrameClassifier(const TemplateSet& templates, const PhonemeSet& set,
                     const ClassifierConfig& config = {});
     FrameLabel classify(const FrameFeatures& frame);
-    // Distance from the frame to each class (best template, and the class network's term),
-    // indexed by phoneme set index; +inf for classes without templates. Valid after classify().
+    // Distance from the frame to each class (best template, the class network's term and the
+    // set's class bias), indexed by phoneme set index; +inf for classes without templates.
+    // Valid after classify().
     std::span<const float> distances() const { return distances_; }
-    // The templates' distances alone, without the class network's term: what the forced aligner
-    // weighs (with the words known, the network's term moved boundaries away from the reference
-    // ones on the real training speakers left out of it: visual groups 84.9 / 53.5 % → 80.8 /
-    // 51.1 % for klettres-en-gb / asterisk-en-allison).
+    // The templates' distances alone, without the class network's term or the class bias: what
+    // the forced aligner weighs (with the words known, the network's term moved boundaries away
+    // from the reference ones on the real training speakers left out of it: visual groups
+    // 84.9 / 53.5 % → 80.8 / 51.1 % for klettres-en-gb / asterisk-en-allison).
     std::span<const float> templateDistances() const {
-        return classNetwork_ ? std::span<const float>(templateDistances_) : distances_;
+        return templateDistances_.empty() ? distances_ : std::span<const float>(templateDistances_);
     }
     // From now on, each frame's least squared distance per block of eight templates
     // (TemplateMatrix) is kept, for a second pass on templates of which only some moved to take
@@ -418,6 +426,8 @@ class FrameClassifier {
     void addClassNetwork(const FrameFeatures& frame);
     std::optional<ClassNetwork> classNetwork_;
     std::vector<int> networkClass_;                 // per network output: its set index (-1: none)
+    void addClassBias();
+    std::vector<float> classBias_;  // per class, dB (TemplateSet::classBiasDb); empty: none
     std::vector<float> likelihoods_, hiddenUnits_;  // the class network's, per frame
     std::vector<float> templateDistances_;
     int sil_ = 0;
