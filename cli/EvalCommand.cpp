@@ -207,17 +207,25 @@ void printRow(std::ostream& out, const std::string& first, const Score& s, bool 
 }
 
 void printConfusion(std::ostream& out, const dsp::ScheduleScore& total, const PhonemeSet& set) {
-    out << "per class (reference): frames, recall, most often taken for\n" << std::fixed;
+    // "heard": frames decided as the class over frames labelled as it, so a class the front end
+    // hears too often (a sink for other classes) or too rarely shows at once: what a template
+    // set's class bias (scripts/fit-class-bias.py) corrects.
+    out << "per class (reference): frames, recall, heard (frames decided as it / its frames), "
+           "most often taken for\n"
+        << std::fixed;
     for (std::size_t r = 0; r < set.size(); ++r) {
-        std::size_t n = 0, worst = r;
+        std::size_t n = 0, decided = 0, worst = r;
         for (std::size_t h = 0; h < set.size(); ++h) {
             n += total.confusion[r][h];
+            decided += total.confusion[h][r];
             if (h != r && total.confusion[r][h] > (worst == r ? 0 : total.confusion[r][worst]))
                 worst = h;
         }
         if (n == 0) continue;
         out << "  " << std::left << std::setw(5) << set[r].name << std::right << std::setw(7) << n
-            << std::setw(8) << std::setprecision(1) << 100.0 * total.confusion[r][r] / n << '%';
+            << std::setw(8) << std::setprecision(1) << 100.0 * total.confusion[r][r] / n << '%'
+            << std::setw(7) << std::setprecision(2) << static_cast<double>(decided) / n << "x"
+            << std::setprecision(1);
         if (worst != r)
             out << "   " << set[worst].name << " (" << 100.0 * total.confusion[r][worst] / n
                 << "%)";

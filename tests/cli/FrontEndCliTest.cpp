@@ -171,6 +171,25 @@ TEST(LipsyncCli, EvalFailsBelowTheFloorAndPassesAboveIt) {
     EXPECT_NE(r.err.find("below the floor"), std::string::npos) << r.err;
 }
 
+// The per-class table says how often each class is heard against how often it is labelled:
+// a class biased out of reach is heard 0 times as often.
+TEST(LipsyncCli, EvalSaysHowOftenEachClassIsHeard) {
+    const auto dir = exampleWav().parent_path();
+    const auto heardBilabials = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = {"eval", "--corpus", dir.string(), "--no-jaw"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const auto r = runLipsync(args);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_NE(r.out.find("heard (frames decided as it / its frames)"), std::string::npos);
+        const auto row = r.out.find("\n  bmp ");
+        if (row == std::string::npos) return -1.0;
+        const auto x = r.out.find('x', row);
+        return std::stod(r.out.substr(r.out.rfind(' ', x) + 1, x - r.out.rfind(' ', x) - 1));
+    };
+    EXPECT_GT(heardBilabials({}), 0.3);
+    EXPECT_EQ(heardBilabials({"--class-bias", "bmp=19"}), 0.0);
+}
+
 // One subfolder per speaker: the jaw is scored per speaker, three ways, through the puppet.
 TEST(LipsyncCli, EvalScoresThePuppetsJawPerSpeaker) {
     const auto dir = scratchDir("cli_eval_speakers");
