@@ -28,10 +28,16 @@ import re
 import subprocess
 import sys
 import tempfile
+import tomllib
 from concurrent.futures import ThreadPoolExecutor
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CLASSES = "sil ah aa ao eh er ih w ow aw oy ay h r l z sh th f d kg bmp".split()
+
+
+def common_classes():
+    """The classes a set's bias may name, in the common set's order (config/phonemes)."""
+    with open(os.path.join(ROOT, "config", "phonemes", "common.toml"), "rb") as f:
+        return [c["name"] for c in tomllib.load(f)["class"]]
 
 
 def parse_args(argv):
@@ -97,7 +103,7 @@ def fit(args):
                 moved = False
                 # Both directions of one class at once; the first class whose move helps is
                 # kept, then the sweep starts again from the first class.
-                for name in CLASSES:
+                for name in common_classes():
                     trials = []
                     for sign in (1, -1):
                         b = dict(bias)
