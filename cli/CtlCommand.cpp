@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "Commands.hpp"
+#include "NameValue.hpp"
 
 namespace lipsyncd::cli {
 
@@ -58,17 +59,11 @@ nlohmann::json valueOf(const ControlArg& arg, const std::string& word) {
 nlohmann::json weightsOf(const ControlArg& arg, std::span<const std::string> words) {
     nlohmann::json weights = nlohmann::json::object();
     for (const auto& word : words) {
-        const auto eq = word.find('=');
-        std::size_t used = 0;
-        double value = 0;
-        try {
-            if (eq != std::string::npos) value = std::stod(word.substr(eq + 1), &used);
-        } catch (const std::exception&) {
-        }
-        if (eq == std::string::npos || eq == 0 || used == 0 || eq + 1 + used != word.size())
+        const auto pair = parseNameValue(word);
+        if (!pair)
             throw CLI::ValidationError(
                 "ctl", "'" + word + "' is not NAME=VALUE: " + std::string(arg.help));
-        weights[word.substr(0, eq)] = value;
+        weights[pair->first] = pair->second;
     }
     return weights;
 }

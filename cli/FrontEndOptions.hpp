@@ -2,11 +2,12 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <cstdlib>
 #include <lipsyncd/dsp.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "NameValue.hpp"
 
 namespace lipsyncd::cli {
 
@@ -97,13 +98,10 @@ struct FrontEndOptions {
         auto set = dsp::TemplateSet::named(templates);
         if (noClassBias) set.classBiasDb.clear();
         for (const auto& item : classBias) {
-            const auto eq = item.find('=');
-            char* end = nullptr;
-            const float db =
-                eq == std::string::npos ? 0.0f : std::strtof(item.c_str() + eq + 1, &end);
-            if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
+            const auto pair = parseNameValue(item);
+            if (!pair)
                 throw InputError("--class-bias: '" + item + "' is not CLASS=DB (e.g. bmp=0.3)");
-            set.classBiasDb[item.substr(0, eq)] = db;
+            set.classBiasDb[pair->first] = static_cast<float>(pair->second);
         }
         if (!classBias.empty()) set.validate("--class-bias");
         return set;

@@ -27,14 +27,15 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
         networkClass_ = classNetwork_->setIndices(set);
         likelihoods_.assign(networkClass_.size(), 0.0f);
         hiddenUnits_.assign(classNetwork_->hiddenUnits(), 0.0f);
-        templateDistances_.assign(set.size(), std::numeric_limits<float>::infinity());
     }
     if (!templates.classBiasDb.empty()) {
         classBias_.assign(set.size(), 0.0f);
         for (const auto& [name, db] : templates.classBiasDb)
             if (const auto i = set.find(name)) classBias_[*i] = db;
-        templateDistances_.assign(set.size(), std::numeric_limits<float>::infinity());
     }
+    // Terms added to the distances: the templates' own are kept apart for the aligner.
+    if (classNetwork_ || !classBias_.empty())
+        templateDistances_.assign(set.size(), std::numeric_limits<float>::infinity());
     matrix_ = std::make_shared<const TemplateMatrix>(templates, set);
     scaledFrame_.assign(matrix_->features(), 0.0f);
     distances_.assign(set.size(), std::numeric_limits<float>::infinity());
@@ -71,18 +72,15 @@ float FrameClassifier::expectedJaw(float best) const {
     return sum > 0 ? weighted / sum : 0.0f;
 }
 
-// The hybrid's scaled likelihoods (Bourlard & Morgan 1994) as distance, the templates' own
-// distances kept for the aligner. Classes the network does not know keep their template distance.
+// The hybrid's scaled likelihoods (Bourlard & Morgan 1994) as distance. Classes the network does
+// not know keep their template distance.
 void FrameClassifier::addClassNetwork(const FrameFeatures& frame) {
-    std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
     classNetwork_->addToDistances(frame.spectrum, networkClass_, config_.classNetworkDb,
                                   config_.classPriorScale, distances_, likelihoods_, hiddenUnits_);
 }
 
-// The set's per-class correction (TemplateSet::classBiasDb), after the network's term; the
-// templates' own distances are kept for the aligner, as addClassNetwork keeps them.
+// The set's per-class correction (TemplateSet::classBiasDb), after the network's term.
 void FrameClassifier::addClassBias() {
-    if (!classNetwork_) std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
     for (std::size_t c = 0; c < distances_.size(); ++c) distances_[c] += classBias_[c];
 }
 
@@ -135,6 +133,8 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
         matrix_->nearest(scaledFrame_, distances_, blockDistances_);
     matrix_->toRms(distances_);  // weighted RMS difference, in dB
 
+    if (!templateDistances_.empty())  // before the terms below: what the aligner weighs
+        std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
     if (classNetwork_) addClassNetwork(frame);
     if (!classBias_.empty()) addClassBias();
 
