@@ -117,7 +117,8 @@ void Resample10ms(benchmark::State& state) {
 }
 BENCHMARK(Resample10ms)->Arg(16000)->Arg(44100)->Arg(48000);
 
-// A whole file as analyzeFile reads it: 4096-sample blocks, libsoxr's own DFT block sizes.
+// 4096-sample blocks as analyzeFile reads them: as a whole file (1: the FIR up to 16 kHz, libsoxr
+// with its own DFT block sizes above) or as live input (0: the FIR at every rate).
 void ResampleFile(benchmark::State& state) {
     const int rate = static_cast<int>(state.range(0));
     const auto& audio = speechAt(rate);

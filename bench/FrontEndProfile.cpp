@@ -125,7 +125,7 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
         Viterbi,
         Segment
     };
-    StageClock clock({"decode (libsndfile, to mono)", "resample to 10 kHz (libsoxr)",
+    StageClock clock({"decode (libsndfile, to mono)", "resample to 10 kHz",
                       "level (RMS, clipping)", "pre-emphasis and window", "autocorrelation",
                       "Levinson-Durbin", "LPC spectrum", "template distances",
                       "class network (likelihoods)", "jaw network (heard jaw)",
