@@ -125,11 +125,10 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
         Viterbi,
         Segment
     };
-    StageClock clock({"decode (libsndfile, to mono)", "resample to 10 kHz",
-                      "level (RMS, clipping)", "pre-emphasis and window", "autocorrelation",
-                      "Levinson-Durbin", "LPC spectrum", "template distances",
-                      "class network (likelihoods)", "jaw network (heard jaw)",
-                      "Viterbi decoder (fixed lag)", "segmenter"});
+    StageClock clock({"decode (libsndfile, to mono)", "resample to 10 kHz", "level (RMS, clipping)",
+                      "pre-emphasis and window", "autocorrelation", "Levinson-Durbin",
+                      "LPC spectrum", "template distances", "class network (likelihoods)",
+                      "jaw network (heard jaw)", "Viterbi decoder (fixed lag)", "segmenter"});
 
     // Decode and resample the whole file in the blocks analyzeFile uses.
     auto decoder = dsp::AudioDecoder::open(file);

@@ -156,7 +156,8 @@ std::optional<PolyphaseResampler> PolyphaseResampler::create(double inputRate, d
                                                              std::size_t maxBlock) {
     const auto whole = [](double r) { return r >= 1 && r <= 1e6 && r == std::round(r); };
     if (!whole(inputRate) || !whole(outputRate)) return std::nullopt;
-    const auto in = static_cast<std::int64_t>(inputRate), out = static_cast<std::int64_t>(outputRate);
+    const auto in = static_cast<std::int64_t>(inputRate),
+               out = static_cast<std::int64_t>(outputRate);
     const std::int64_t g = std::gcd(in, out);
     const auto up = static_cast<int>(out / g), down = static_cast<int>(in / g);
     if (up > kMaxPhases) return std::nullopt;
@@ -165,8 +166,8 @@ std::optional<PolyphaseResampler> PolyphaseResampler::create(double inputRate, d
     return r;
 }
 
-PolyphaseResampler::PolyphaseResampler(int up, int down, const LowPassSpec& spec,
-                                       double inputRate, std::size_t maxBlock)
+PolyphaseResampler::PolyphaseResampler(int up, int down, const LowPassSpec& spec, double inputRate,
+                                       std::size_t maxBlock)
     : up_(up), down_(down), maxBlock_(maxBlock) {
     const double outputRate = inputRate * up / down;
     const double nyquist = std::min(inputRate, outputRate) / 2;
@@ -197,9 +198,9 @@ PolyphaseResampler::PolyphaseResampler(int up, int down, const LowPassSpec& spec
     buffered_ = static_cast<std::size_t>(half_ - 1);
     buffer_.assign(maxBlock + 3 * taps_ + static_cast<std::size_t>(down / up) + 16, 0.0f);
     const double perInput = static_cast<double>(up) / down;
-    out_.resize(static_cast<std::size_t>(
-                    std::ceil(static_cast<double>(maxBlock + 3 * taps_) * perInput)) +
-                4);
+    out_.resize(
+        static_cast<std::size_t>(std::ceil(static_cast<double>(maxBlock + 3 * taps_) * perInput)) +
+        4);
 }
 
 void PolyphaseResampler::append(std::span<const float> input) {
@@ -222,8 +223,8 @@ void PolyphaseResampler::produce(std::int64_t available, std::int64_t end) {
         phase += stepPhase;
         if (phase >= up_) phase -= up_, ++q;
     }
-    const FilterRun run{coefs_.data(), taps_, up_, down_, buffer_.data(), bufferStart_, half_,
-                        out_.data()};
+    const FilterRun run{coefs_.data(),  taps_,        up_,   down_,
+                        buffer_.data(), bufferStart_, half_, out_.data()};
     runFilter(run, q_, phase_, count);
     produced_ = count;
     q_ = q;

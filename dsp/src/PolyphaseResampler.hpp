@@ -16,9 +16,9 @@
 namespace lipsyncd::dsp {
 
 struct LowPassSpec {
-    double attenuationDb;   // in the stopband
-    double passbandEnd;     // fraction of the lower of the two Nyquist frequencies
-    double stopbandBegin;   // the same; above 1 lets the band's top few per cent alias a little
+    double attenuationDb;  // in the stopband
+    double passbandEnd;    // fraction of the lower of the two Nyquist frequencies
+    double stopbandBegin;  // the same; above 1 lets the band's top few per cent alias a little
 };
 
 class PolyphaseResampler {
@@ -26,8 +26,7 @@ class PolyphaseResampler {
     // Null when the rates are not whole numbers of Hz or the ratio needs more phases or
     // coefficients than a small table holds (the caller then uses libsoxr).
     static std::optional<PolyphaseResampler> create(double inputRate, double outputRate,
-                                                     const LowPassSpec& spec,
-                                                     std::size_t maxBlock);
+                                                    const LowPassSpec& spec, std::size_t maxBlock);
 
     // Resamples one block (at most maxBlock samples); the output stays valid until the next
     // call. With `flush` the input ends: what is held back comes out, the end padded with zeros.
@@ -43,11 +42,11 @@ class PolyphaseResampler {
     void produce(std::int64_t available, std::int64_t end);
     void dropConsumed();
 
-    int up_, down_;                // L and M: output n lies at input time n·M/L
-    std::size_t taps_ = 0;         // per phase, a multiple of the vector width
-    std::int64_t half_ = 0;        // output n reads input from ⌊n·M/L⌋ − half + 1 on
-    std::vector<float> coefs_;     // phase-major: coefs_[p·taps + j]
-    std::vector<float> buffer_;    // input from absolute index bufferStart_ on
+    int up_, down_;              // L and M: output n lies at input time n·M/L
+    std::size_t taps_ = 0;       // per phase, a multiple of the vector width
+    std::int64_t half_ = 0;      // output n reads input from ⌊n·M/L⌋ − half + 1 on
+    std::vector<float> coefs_;   // phase-major: coefs_[p·taps + j]
+    std::vector<float> buffer_;  // input from absolute index bufferStart_ on
     std::size_t buffered_ = 0;
     std::int64_t bufferStart_ = 0;
     std::int64_t inputCount_ = 0;  // input samples taken so far

@@ -32,7 +32,8 @@ std::vector<float> resample(dsp::PolyphaseResampler& r, const std::vector<float>
     return y;
 }
 
-std::vector<float> resample(int from, int to, const std::vector<float>& x, std::size_t block = 4096) {
+std::vector<float> resample(int from, int to, const std::vector<float>& x,
+                            std::size_t block = 4096) {
     auto r = dsp::PolyphaseResampler::create(from, to, kMedium, 4096);
     EXPECT_TRUE(r.has_value()) << from << " -> " << to;
     return r ? resample(*r, x, block) : std::vector<float>{};
@@ -114,7 +115,7 @@ TEST(PolyphaseResampler, ForgetsABadSampleOnceItsFilterHasPassed) {
 
 TEST(PolyphaseResampler, LeavesOddRatiosToLibsoxr) {
     EXPECT_FALSE(dsp::PolyphaseResampler::create(11025.5, 10000, kMedium, 4096));  // not whole Hz
-    EXPECT_FALSE(dsp::PolyphaseResampler::create(10007, 10000, kMedium, 4096));  // 10,000 phases
+    EXPECT_FALSE(dsp::PolyphaseResampler::create(10007, 10000, kMedium, 4096));    // 10,000 phases
     // StreamResampler still converts them, through libsoxr.
     for (const double rate : {11025.5, 10007.0}) {
         dsp::StreamResampler r(rate, 10000, dsp::ResamplerQuality::Medium, 8192);

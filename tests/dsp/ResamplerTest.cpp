@@ -85,9 +85,10 @@ TEST(StreamResampler, AWholeFileGivesTheLiveSamples) {
         int rate;
         dsp::ResamplerQuality quality;
     };
-    for (const auto& [x, rate, quality] : {Case{speech.samples, speech.rate, dsp::ResamplerQuality::Medium},
-                                           Case{speech.samples, speech.rate, dsp::ResamplerQuality::High},
-                                           Case{at16k, 16000, dsp::ResamplerQuality::Medium}}) {
+    for (const auto& [x, rate, quality] :
+         {Case{speech.samples, speech.rate, dsp::ResamplerQuality::Medium},
+          Case{speech.samples, speech.rate, dsp::ResamplerQuality::High},
+          Case{at16k, 16000, dsp::ResamplerQuality::Medium}}) {
         auto run = [&](dsp::ResamplerUse use) {
             dsp::StreamResampler r(rate, 10000, quality, 4096, use);
             std::vector<float> y;
@@ -118,6 +119,7 @@ TEST(StreamResampler, AWholeFileGivesTheLiveSamples) {
         if (rate == 16000)
             EXPECT_EQ(fileDelay, liveDelay);  // the same FIR
         else
-            EXPECT_GT(fileDelay, liveDelay);  // what the larger blocks hold back: why live keeps small ones
+            EXPECT_GT(fileDelay,
+                      liveDelay);  // what the larger blocks hold back: why live keeps small ones
     }
 }
