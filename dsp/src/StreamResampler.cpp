@@ -133,10 +133,14 @@ StreamResampler::StreamResampler(double inputRate, double outputRate, ResamplerQ
         state_->fir->tapsPerPhase() > kMostWholeFileTaps)
         state_->fir.reset();
     if (state_->fir) {
-        auto probe = *PolyphaseResampler::create(inputRate, outputRate, *firSpec(quality),
-                                                 static_cast<std::size_t>(inputRate / 100) + 1);
+        // A twin by copy (designing the filter again costs more than copying it).
+        auto probe = *state_->fir;
         delaySeconds_ = measureHeldBack(inputRate, outputRate, [&](std::span<const float> in) {
-            return probe.process(in, false).size();
+            std::size_t made = 0;  // in pieces of at most maxBlock, as process() takes them
+            for (std::size_t at = 0; at < in.size(); at += maxBlock)
+                made +=
+                    probe.process(in.subspan(at, std::min(maxBlock, in.size() - at)), false).size();
+            return made;
         });
         return;
     }
