@@ -174,6 +174,27 @@ LIPSYNCD_VECTOR_CLONES void runFilter(const FilterRun& r, std::int64_t q, int ph
 }
 }  // namespace
 
+namespace {
+// The filter a spec asks for at these rates: edges in cycles per input sample, the window's
+// shape, its half length and the taps a phase holds (rounded up to whole vectors).
+struct FilterShape {
+    double pass, stop, beta;
+    std::int64_t half;
+    std::size_t taps;
+};
+
+FilterShape shapeFor(double inputRate, double outputRate, const LowPassSpec& spec) {
+    const double nyquist = std::min(inputRate, outputRate) / 2;
+    FilterShape f{};
+    f.pass = spec.passbandEnd * nyquist / inputRate;
+    f.stop = spec.stopbandBegin * nyquist / inputRate;
+    f.beta = kaiserBeta(spec.attenuationDb);
+    f.half = kaiserHalfLength(spec.attenuationDb, f.stop - f.pass);
+    f.taps = (static_cast<std::size_t>(2 * f.half) + kVectorLanes - 1) / kVectorLanes * kVectorLanes;
+    return f;
+}
+}  // namespace
+
 std::optional<PolyphaseResampler> PolyphaseResampler::create(double inputRate, double outputRate,
                                                              const LowPassSpec& spec,
                                                              std::size_t maxBlock) {
@@ -184,27 +205,24 @@ std::optional<PolyphaseResampler> PolyphaseResampler::create(double inputRate, d
     const std::int64_t g = std::gcd(in, out);
     const auto up = static_cast<int>(out / g), down = static_cast<int>(in / g);
     if (up > kMaxPhases) return std::nullopt;
-    PolyphaseResampler r(up, down, spec, inputRate, maxBlock);
-    if (r.coefs_.size() > kMaxCoefficients) return std::nullopt;
-    return r;
+    const FilterShape shape = shapeFor(inputRate, outputRate, spec);
+    if (static_cast<std::size_t>(up) * shape.taps > kMaxCoefficients) return std::nullopt;
+    return PolyphaseResampler(up, down, spec, inputRate, maxBlock);
 }
 
 PolyphaseResampler::PolyphaseResampler(int up, int down, const LowPassSpec& spec, double inputRate,
                                        std::size_t maxBlock)
     : up_(up), down_(down), maxBlock_(maxBlock) {
-    const double outputRate = inputRate * up / down;
-    const double nyquist = std::min(inputRate, outputRate) / 2;
-    const double pass = spec.passbandEnd * nyquist / inputRate;  // cycles per input sample
-    const double stop = spec.stopbandBegin * nyquist / inputRate;
-    const double beta = kaiserBeta(spec.attenuationDb);
-    half_ = kaiserHalfLength(spec.attenuationDb, stop - pass);
+    const FilterShape shape = shapeFor(inputRate, inputRate * up / down, spec);
+    half_ = shape.half;
+    taps_ = shape.taps;
     const auto span = static_cast<std::size_t>(2 * half_);
-    taps_ = (span + kVectorLanes - 1) / kVectorLanes * kVectorLanes;
     coefs_.assign(static_cast<std::size_t>(up) * taps_, 0.0f);
     // Phase p serves the outputs that fall p/L of a sample past an input; tap j weighs the
     // input half − 1 − j samples before that point (after it, for j ≥ half). Each phase is
     // scaled to a DC gain of exactly 1, so no phase is louder than the next.
-    const KaiserSinc h{(pass + stop) / 2, beta, static_cast<double>(half_), besselI0(beta)};
+    const KaiserSinc h{(shape.pass + shape.stop) / 2, shape.beta, static_cast<double>(half_),
+                       besselI0(shape.beta)};
     std::vector<double> phase(span);
     for (int p = 0; p < up; ++p) {
         double sum = 0;
