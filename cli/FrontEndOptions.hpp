@@ -32,7 +32,11 @@ struct FrontEndOptions {
         cmd.add_option("--raw", rawSpec,
                        "Input is headerless PCM: RATE:FORMAT:CHANNELS, e.g. 16000:s16:1 "
                        "(formats s8 u8 s16 s24 s32 f32 f64, little-endian)");
-        cmd.add_option("--resampler", resampler, "Resampler quality")
+        cmd.add_option("--resampler", resampler,
+                       "Resampler to the 10 kHz analysis rate. medium (the passband the "
+                       "templates were trained through) or low (shorter): a polyphase FIR "
+                       "holding back a few ms (libsoxr for odd rates and whole files above "
+                       "16 kHz); high, veryhigh: libsoxr's steeper filters")
             ->check(CLI::IsMember({"low", "medium", "high", "veryhigh"}))
             ->capture_default_str();
         // Shorter runs are flicker and merge into their neighbour; longer holds mean fewer,
