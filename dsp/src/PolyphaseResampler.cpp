@@ -190,7 +190,8 @@ FilterShape shapeFor(double inputRate, double outputRate, const LowPassSpec& spe
     f.stop = spec.stopbandBegin * nyquist / inputRate;
     f.beta = kaiserBeta(spec.attenuationDb);
     f.half = kaiserHalfLength(spec.attenuationDb, f.stop - f.pass);
-    f.taps = (static_cast<std::size_t>(2 * f.half) + kVectorLanes - 1) / kVectorLanes * kVectorLanes;
+    f.taps =
+        (static_cast<std::size_t>(2 * f.half) + kVectorLanes - 1) / kVectorLanes * kVectorLanes;
     return f;
 }
 }  // namespace

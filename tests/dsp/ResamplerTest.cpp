@@ -59,8 +59,8 @@ TEST(StreamResampler, ReportedDelayBoundsTheMeasuredOne) {
     // A sample's wait depends on where it falls in a block (the 10 ms one; for libsoxr, at High,
     // its own processing block too): sweep the impulse across a block and take the longest wait.
     // delaySeconds() must bound it, and not loosely.
-    for (auto quality : {dsp::ResamplerQuality::Medium, dsp::ResamplerQuality::Low,
-                         dsp::ResamplerQuality::High}) {
+    for (auto quality :
+         {dsp::ResamplerQuality::Medium, dsp::ResamplerQuality::Low, dsp::ResamplerQuality::High}) {
         const double reported = dsp::StreamResampler(16000, 10000, quality, 4096).delaySeconds();
         double worst = 0;
         for (std::size_t impulse = 8000; impulse < 8000 + 1200; impulse += 37) {
