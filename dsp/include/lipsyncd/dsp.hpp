@@ -2,9 +2,9 @@
 //
 //   AudioDecoder        libsndfile: WAV/FLAC/OGG/raw PCM, any rate and channel count → mono
 //                       float (mixed, or one chosen channel), read in blocks.
-//   StreamResampler     streaming polyphase FIR (or libsoxr) → the analysis rate (10 kHz); reports
-//   delay. FrameAnalyzer       one frame: pre-emphasis, Hamming window, autocorrelation, lag
-//   window,
+//   StreamResampler     a polyphase FIR (or libsoxr), streaming → the analysis rate (10 kHz);
+//                       reports its delay.
+//   FrameAnalyzer       one frame: pre-emphasis, Hamming window, autocorrelation, lag window,
 //                       white-noise correction, Levinson–Durbin, LPC log spectrum, energy.
 //   TemplateSet         spectral templates per phoneme class (config/templates/*.json).
 //   FrameClassifier     nearest templates, energy gate with adaptive noise floor, voicing.
