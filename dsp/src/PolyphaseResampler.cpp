@@ -64,6 +64,23 @@ struct KaiserSinc {
     }
 };
 
+// The time of the output after one at q + phase/L: M/L later, as a whole part and a phase (no
+// division per output).
+struct OutputClock {
+    std::int64_t q;
+    int phase;
+    std::int64_t step;
+    int stepPhase, up;
+    static OutputClock at(std::int64_t q, int phase, int up, int down) {
+        return {q, phase, down / up, down % up, up};
+    }
+    void advance() {
+        q += step;
+        phase += stepPhase;
+        if (phase >= up) phase -= up, ++q;
+    }
+};
+
 struct FilterRun {
     const float* coefs;
     std::size_t taps;
@@ -71,6 +88,14 @@ struct FilterRun {
     const float* buffer;  // input from absolute index `bufferStart` on
     std::int64_t bufferStart, half;
     float* out;
+    // The taps of the output at `clock`, and its input window (half − 1 samples before its time
+    // to `taps` − half after).
+    const float* tapsAt(const OutputClock& clock) const {
+        return coefs + static_cast<std::size_t>(clock.phase) * taps;
+    }
+    const float* windowAt(const OutputClock& clock) const {
+        return buffer + (clock.q - half + 1 - bufferStart);
+    }
 };
 
 // The sum of the lanes, as a tree (three dependent adds, not seven).
@@ -81,111 +106,72 @@ struct FilterRun {
     return quarter[0] + quarter[1];
 }
 
-// The time of the output after one at q + phase/L: M/L later, as a whole part and a phase (no
-// division per output).
-struct OutputClock {
-    std::int64_t q;
-    int phase;
-    std::int64_t step;
-    int stepPhase, up;
-    void advance() {
-        q += step;
-        phase += stepPhase;
-        if (phase >= up) phase -= up, ++q;
-    }
-};
-
-// Outputs n, n + L, n + 2L, n + 3L have the same phase, and their windows lie M samples apart:
-// each load of the phase's taps serves all four, which halves the loads the dot products wait on.
-// Writes L·kGroup outputs from `clock` on.
-constexpr std::size_t kGroup = 4;
-[[gnu::always_inline]] inline void samePhaseOutputs(const FilterRun& r, OutputClock clock,
-                                                    float* out) {
-    const auto up = static_cast<std::size_t>(r.up);
-    for (std::size_t i = 0; i < up; ++i, clock.advance()) {
-        const float* c = r.coefs + static_cast<std::size_t>(clock.phase) * r.taps;
-        const float* x = r.buffer + (clock.q - r.half + 1 - r.bufferStart);
-        // Summed as oneOutput sums: the same output whichever path made it.
-        FloatLanes even[kGroup] = {}, odd[kGroup] = {};
-        std::size_t j = 0;
-        for (; j + 2 * kVectorLanes <= r.taps; j += 2 * kVectorLanes) {
-            FloatLanes a, b;
-            std::memcpy(&a, c + j, sizeof a);
-            std::memcpy(&b, c + j + kVectorLanes, sizeof b);
-#pragma GCC unroll 4
-            for (std::size_t k = 0; k < kGroup; ++k) {
-                FloatLanes u, v;
-                const float* xk = x + k * static_cast<std::size_t>(r.down) + j;
-                std::memcpy(&u, xk, sizeof u);
-                std::memcpy(&v, xk + kVectorLanes, sizeof v);
-                even[k] += a * u;
-                odd[k] += b * v;
-            }
-        }
-        if (j < r.taps) {
-            FloatLanes a;
-            std::memcpy(&a, c + j, sizeof a);
-            for (std::size_t k = 0; k < kGroup; ++k) {
-                FloatLanes u;
-                std::memcpy(&u, x + k * static_cast<std::size_t>(r.down) + j, sizeof u);
-                even[k] += a * u;
-            }
-        }
-        for (std::size_t k = 0; k < kGroup; ++k) out[i + k * up] = laneSum(even[k] + odd[k]);
-    }
-}
-
-// One output at a time, for what is left over from whole groups (and 10 ms live blocks).
-[[gnu::always_inline]] inline float oneOutput(const FilterRun& r, const OutputClock& clock) {
-    const float* c = r.coefs + static_cast<std::size_t>(clock.phase) * r.taps;
-    const float* x = r.buffer + (clock.q - r.half + 1 - r.bufferStart);
-    FloatLanes even = {}, odd = {};
+// K dot products of one phase's taps `c` with K input windows `stride` samples apart from `x`,
+// written `outStride` apart. The taps' vectors go alternately into two partial sums, added last,
+// for any K: an output is the same bit for bit whichever K computed it.
+template <std::size_t K>
+[[gnu::always_inline]] inline void windowDots(const float* c, const float* x, std::size_t stride,
+                                              std::size_t taps, float* out, std::size_t outStride) {
+    FloatLanes even[K] = {}, odd[K] = {};
     std::size_t j = 0;
-    for (; j + 2 * kVectorLanes <= r.taps; j += 2 * kVectorLanes) {
-        FloatLanes a, b, u, v;
+    for (; j + 2 * kVectorLanes <= taps; j += 2 * kVectorLanes) {
+        FloatLanes a, b;
         std::memcpy(&a, c + j, sizeof a);
-        std::memcpy(&u, x + j, sizeof u);
         std::memcpy(&b, c + j + kVectorLanes, sizeof b);
-        std::memcpy(&v, x + j + kVectorLanes, sizeof v);
-        even += a * u;
-        odd += b * v;
+#pragma GCC unroll 4
+        for (std::size_t k = 0; k < K; ++k) {
+            FloatLanes u, v;
+            std::memcpy(&u, x + k * stride + j, sizeof u);
+            std::memcpy(&v, x + k * stride + j + kVectorLanes, sizeof v);
+            even[k] += a * u;
+            odd[k] += b * v;
+        }
     }
-    if (j < r.taps) {
-        FloatLanes a, u;
+    if (j < taps) {
+        FloatLanes a;
         std::memcpy(&a, c + j, sizeof a);
-        std::memcpy(&u, x + j, sizeof u);
-        even += a * u;
+        for (std::size_t k = 0; k < K; ++k) {
+            FloatLanes u;
+            std::memcpy(&u, x + k * stride + j, sizeof u);
+            even[k] += a * u;
+        }
     }
-    return laneSum(even + odd);
+    for (std::size_t k = 0; k < K; ++k) out[k * outStride] = laneSum(even[k] + odd[k]);
 }
 
 // `count` outputs from output time q + phase/L on, each the dot product of its phase's taps with
-// the input window that ends `half` samples past its time.
+// its input window. Outputs n, n + L, n + 2L, n + 3L have the same phase and windows M samples
+// apart: in whole groups of 4L outputs each load of a phase's taps serves four (2.3 times
+// faster than one at a time); what is left over (and 10 ms live blocks) goes one at a time.
 LIPSYNCD_VECTOR_CLONES void runFilter(const FilterRun& r, std::int64_t q, int phase,
                                       std::size_t count) {
-    OutputClock clock{q, phase, r.down / r.up, r.down % r.up, r.up};
-    const std::size_t group = kGroup * static_cast<std::size_t>(r.up);
+    constexpr std::size_t kGroup = 4;
+    auto clock = OutputClock::at(q, phase, r.up, r.down);
+    const auto up = static_cast<std::size_t>(r.up), down = static_cast<std::size_t>(r.down);
     std::size_t n = 0;
-    for (; n + group <= count; n += group) {
-        samePhaseOutputs(r, clock, r.out + n);
-        clock.q += static_cast<std::int64_t>(kGroup) * r.down;  // L outputs later: M samples
+    for (; n + kGroup * up <= count; n += kGroup * up) {
+        auto first = clock;
+        for (std::size_t i = 0; i < up; ++i, first.advance())
+            windowDots<kGroup>(r.tapsAt(first), r.windowAt(first), down, r.taps, r.out + n + i, up);
+        clock.q += static_cast<std::int64_t>(kGroup * down);  // L outputs later: M samples
     }
-    for (; n < count; ++n, clock.advance()) r.out[n] = oneOutput(r, clock);
+    for (; n < count; ++n, clock.advance())
+        windowDots<1>(r.tapsAt(clock), r.windowAt(clock), 0, r.taps, r.out + n, 0);
 }
 }  // namespace
 
-namespace {
 // The filter a spec asks for at these rates: edges in cycles per input sample, the window's
 // shape, its half length and the taps a phase holds (rounded up to whole vectors).
-struct FilterShape {
+struct PolyphaseResampler::Shape {
     double pass, stop, beta;
     std::int64_t half;
     std::size_t taps;
 };
 
-FilterShape shapeFor(double inputRate, double outputRate, const LowPassSpec& spec) {
+PolyphaseResampler::Shape PolyphaseResampler::shapeFor(double inputRate, double outputRate,
+                                                       const LowPassSpec& spec) {
     const double nyquist = std::min(inputRate, outputRate) / 2;
-    FilterShape f{};
+    Shape f{};
     f.pass = spec.passbandEnd * nyquist / inputRate;
     f.stop = spec.stopbandBegin * nyquist / inputRate;
     f.beta = kaiserBeta(spec.attenuationDb);
@@ -194,7 +180,6 @@ FilterShape shapeFor(double inputRate, double outputRate, const LowPassSpec& spe
         (static_cast<std::size_t>(2 * f.half) + kVectorLanes - 1) / kVectorLanes * kVectorLanes;
     return f;
 }
-}  // namespace
 
 std::optional<PolyphaseResampler> PolyphaseResampler::create(double inputRate, double outputRate,
                                                              const LowPassSpec& spec,
@@ -206,17 +191,13 @@ std::optional<PolyphaseResampler> PolyphaseResampler::create(double inputRate, d
     const std::int64_t g = std::gcd(in, out);
     const auto up = static_cast<int>(out / g), down = static_cast<int>(in / g);
     if (up > kMaxPhases) return std::nullopt;
-    const FilterShape shape = shapeFor(inputRate, outputRate, spec);
+    const Shape shape = shapeFor(inputRate, outputRate, spec);
     if (static_cast<std::size_t>(up) * shape.taps > kMaxCoefficients) return std::nullopt;
-    return PolyphaseResampler(up, down, spec, inputRate, maxBlock);
+    return PolyphaseResampler(up, down, shape, maxBlock);
 }
 
-PolyphaseResampler::PolyphaseResampler(int up, int down, const LowPassSpec& spec, double inputRate,
-                                       std::size_t maxBlock)
-    : up_(up), down_(down), maxBlock_(maxBlock) {
-    const FilterShape shape = shapeFor(inputRate, inputRate * up / down, spec);
-    half_ = shape.half;
-    taps_ = shape.taps;
+PolyphaseResampler::PolyphaseResampler(int up, int down, const Shape& shape, std::size_t maxBlock)
+    : up_(up), down_(down), taps_(shape.taps), half_(shape.half), maxBlock_(maxBlock) {
     const auto span = static_cast<std::size_t>(2 * half_);
     coefs_.assign(static_cast<std::size_t>(up) * taps_, 0.0f);
     // Phase p serves the outputs that fall p/L of a sample past an input; tap j weighs the
@@ -254,24 +235,18 @@ void PolyphaseResampler::append(std::span<const float> input) {
 // Every output whose window lies within the buffer (it ends before absolute index `available`)
 // and, when the input has ended, whose time is before its end (q + phase/L < `end`).
 void PolyphaseResampler::produce(std::int64_t available, std::int64_t end) {
-    const std::int64_t step = down_ / up_;
-    const int stepPhase = down_ % up_;
-    std::int64_t q = q_;
-    int phase = phase_;
+    auto clock = OutputClock::at(q_, phase_, up_, down_);
     std::size_t count = 0;
     // Output q + phase/L reads input q − half + 1 .. q − half + taps.
-    while (q - half_ + 1 + static_cast<std::int64_t>(taps_) <= available && q < end) {
+    for (; clock.q - half_ + 1 + static_cast<std::int64_t>(taps_) <= available && clock.q < end;
+         clock.advance())
         ++count;
-        q += step;
-        phase += stepPhase;
-        if (phase >= up_) phase -= up_, ++q;
-    }
     const FilterRun run{coefs_.data(),  taps_,        up_,   down_,
                         buffer_.data(), bufferStart_, half_, out_.data()};
     runFilter(run, q_, phase_, count);
     produced_ = count;
-    q_ = q;
-    phase_ = phase;
+    q_ = clock.q;
+    phase_ = clock.phase;
 }
 
 void PolyphaseResampler::dropConsumed() {
@@ -288,13 +263,12 @@ std::span<const float> PolyphaseResampler::process(std::span<const float> input,
     if (ended_) return {};
     if (input.size() > maxBlock_) throw std::logic_error("resampler: block larger than maxBlock");
     append(input);
-    inputCount_ += static_cast<std::int64_t>(input.size());
     std::int64_t end = std::numeric_limits<std::int64_t>::max();
     if (flush && input.empty()) {
         // The input ends: zeros after it, and outputs only up to its last sample's time.
+        end = bufferStart_ + static_cast<std::int64_t>(buffered_);
         std::fill_n(buffer_.begin() + static_cast<std::ptrdiff_t>(buffered_), taps_, 0.0f);
         buffered_ += taps_;
-        end = inputCount_;
         ended_ = true;
     }
     produce(bufferStart_ + static_cast<std::int64_t>(buffered_), end);

@@ -36,8 +36,9 @@ class PolyphaseResampler {
     int phases() const { return up_; }
 
   private:
-    PolyphaseResampler(int up, int down, const LowPassSpec& spec, double inputRate,
-                       std::size_t maxBlock);
+    struct Shape;
+    static Shape shapeFor(double inputRate, double outputRate, const LowPassSpec& spec);
+    PolyphaseResampler(int up, int down, const Shape& shape, std::size_t maxBlock);
     void append(std::span<const float> input);
     void produce(std::int64_t available, std::int64_t end);
     void dropConsumed();
@@ -48,10 +49,9 @@ class PolyphaseResampler {
     std::vector<float> coefs_;   // phase-major: coefs_[p·taps + j]
     std::vector<float> buffer_;  // input from absolute index bufferStart_ on
     std::size_t buffered_ = 0;
-    std::int64_t bufferStart_ = 0;
-    std::int64_t inputCount_ = 0;  // input samples taken so far
-    std::int64_t q_ = 0;           // the next output's time, ⌊n·M/L⌋ ...
-    int phase_ = 0;                // ... and n·M mod L
+    std::int64_t bufferStart_ = 0;  // bufferStart_ + buffered_: input samples taken so far
+    std::int64_t q_ = 0;            // the next output's time, ⌊n·M/L⌋ ...
+    int phase_ = 0;                 // ... and n·M mod L
     bool ended_ = false;
     std::vector<float> out_;
     std::size_t produced_ = 0;
