@@ -3,6 +3,7 @@
 // likelihoods (Bourlard & Morgan 1994, the hybrid of a multilayer perceptron and an HMM).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <lipsyncd/dsp.hpp>
 
 #include "HiddenLayer.hpp"
@@ -24,8 +25,13 @@ float logSumExp(std::span<const float> z) {
 }
 }  // namespace
 
-// Per frame, the hidden sums as the jaw network's, then the output layer unit by unit: a silent
-// (rectified to 0) unit is skipped, and each unit's weights to the classes lie side by side.
+// Per frame, the hidden sums as the jaw network's, then the output layer eight classes at a
+// time, each block's sums kept in a register while every unit adds to them in turn (a silent
+// unit, rectified to 0, adds 0). Each class's sum is taken in the same order as one unit at a
+// time would take it, so the result does not depend on the blocks: the last block overlaps the
+// one before when the classes are not a multiple of eight, and computes those classes again,
+// to the same values. Testing each unit for silence instead was a branch mispredicted about half
+// the time, and adding unit by unit into memory waited on its own stores.
 // The softmax's normaliser is the same for every class, and only differences between classes
 // are used, so it is left out: no exponential in the frame loop.
 LIPSYNCD_VECTOR_CLONES void ClassNetwork::scaledLogLikelihoods(std::span<const float> features,
@@ -33,13 +39,27 @@ LIPSYNCD_VECTOR_CLONES void ClassNetwork::scaledLogLikelihoods(std::span<const f
                                                                std::span<float> scratch,
                                                                float priorScale) const {
     network::hiddenSums(hiddenLayer(*this), features, scratch.data());
-    const std::size_t count = outputBias.size();
-    for (std::size_t c = 0; c < count; ++c) out[c] = outputBias[c] - priorScale * logPrior[c];
-    for (std::size_t h = 0; h < hiddenBias.size(); ++h) {
-        const float a = scratch[h];
-        if (!(a > 0)) continue;  // rectified to 0 (or not a number: nothing to add)
-        const float* w = outputWeights[h].data();
-        for (std::size_t c = 0; c < count; ++c) out[c] += w[c] * a;
+    const std::size_t count = outputBias.size(), units = hiddenBias.size();
+    for (std::size_t h = 0; h < units; ++h)
+        scratch[h] = scratch[h] > 0 ? scratch[h] : 0.0f;  // rectified; not a number: 0
+    if (count < kVectorLanes) {
+        for (std::size_t c = 0; c < count; ++c) {
+            out[c] = outputBias[c] - priorScale * logPrior[c];
+            for (std::size_t h = 0; h < units; ++h) out[c] += outputWeights[h][c] * scratch[h];
+        }
+    } else {
+        for (std::size_t block = 0; block < count; block += kVectorLanes) {
+            const std::size_t c = std::min(block, count - kVectorLanes);
+            FloatLanes sum, prior, weights;
+            std::memcpy(&sum, &outputBias[c], sizeof sum);
+            std::memcpy(&prior, &logPrior[c], sizeof prior);
+            sum -= priorScale * prior;
+            for (std::size_t h = 0; h < units; ++h) {
+                std::memcpy(&weights, &outputWeights[h][c], sizeof weights);
+                sum += weights * scratch[h];
+            }
+            std::memcpy(&out[c], &sum, sizeof sum);
+        }
     }
     for (std::size_t c = 0; c < count; ++c)
         if (!std::isfinite(out[c])) out[c] = 0;

@@ -211,6 +211,58 @@ TEST(ClassNetwork, TravelsWithTheTemplatesAndIsValidated) {
     test::expectRejected(bad, "class_network.classes[1]: 'aa' listed twice");
 }
 
+// The output layer is summed eight classes at a time: every class's scaled likelihood must be
+// exactly the plain sum over the units in order, silent (rectified) units adding nothing and a
+// unit that is not a number counting as silent, whatever the number of classes (fewer than a
+// block, a whole block, and blocks that overlap at the end).
+TEST(ClassNetwork, EachClassIsTheSumOverItsUnitsWhateverTheBlocks) {
+    std::mt19937 rng(11);
+    std::normal_distribution<float> value(0, 1);
+    const std::size_t features = 5, units = 13;
+    for (const std::size_t count : {3u, 8u, 22u}) {
+        ClassNetwork net;
+        net.inputMean.assign(features, 0.5f);
+        net.inputScale.assign(features, 2.0f);
+        net.hiddenWeights.assign(features, std::vector<float>(units));
+        for (auto& row : net.hiddenWeights)
+            for (auto& w : row) w = value(rng);
+        for (std::size_t h = 0; h < units; ++h) net.hiddenBias.push_back(value(rng));
+        net.outputWeights.assign(units, std::vector<float>(count));
+        for (auto& row : net.outputWeights)
+            for (auto& w : row) w = value(rng);
+        for (std::size_t c = 0; c < count; ++c) {
+            net.outputBias.push_back(value(rng));
+            net.logPrior.push_back(-std::abs(value(rng)));
+        }
+        for (int frame = 0; frame < 20; ++frame) {
+            std::vector<float> x(features);
+            for (auto& v : x) v = value(rng);
+            if (frame == 7) x[2] = std::numeric_limits<float>::quiet_NaN();  // NaN units
+            std::vector<float> hidden(units), expected(count), out(count), scratch(units);
+            int silent = 0;
+            for (std::size_t h = 0; h < units; ++h) {
+                hidden[h] = net.hiddenBias[h];
+                for (std::size_t i = 0; i < features; ++i)
+                    hidden[h] +=
+                        net.hiddenWeights[i][h] * ((x[i] - net.inputMean[i]) * net.inputScale[i]);
+                silent += !(hidden[h] > 0);
+            }
+            for (std::size_t c = 0; c < count; ++c) {
+                expected[c] = net.outputBias[c] - 0.5f * net.logPrior[c];
+                for (std::size_t h = 0; h < units; ++h)
+                    if (hidden[h] > 0) expected[c] += net.outputWeights[h][c] * hidden[h];
+            }
+            net.scaledLogLikelihoods(x, out, scratch, 0.5f);
+            for (std::size_t c = 0; c < count; ++c)
+                EXPECT_EQ(out[c], expected[c])
+                    << count << " classes, frame " << frame << ", class " << c;
+            if (frame == 0) {
+                EXPECT_GT(silent, 0);  // the rectifier is exercised
+            }
+        }
+    }
+}
+
 // A labeller marks what it doubts with confidence 0 (scripts: a class its aligner places badly in
 // some recordings); those frames teach neither the templates nor the networks, and everything
 // else is learnt as before.
