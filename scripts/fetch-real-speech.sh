@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Fetches recordings of real people from Debian packages and labels them, for training and
-# evaluating the front end (the speakers and their train/dev/tune split: config/corpus/real-speakers.txt).
+# evaluating the front end (the speakers and their train/networks/dev/tune split:
+# config/corpus/real-speakers.txt).
 #
-#   scripts/fetch-real-speech.sh OUT_DIR                # every speaker: OUT_DIR/{train,dev}/SPEAKER/
+#   scripts/fetch-real-speech.sh OUT_DIR                # every speaker: OUT_DIR/SPLIT/SPEAKER/
 #   scripts/fetch-real-speech.sh OUT_DIR --subset 8     # the first 8 files of each speaker
 #   scripts/fetch-real-speech.sh OUT_DIR --split dev    # only the dev speakers
 #   scripts/fetch-real-speech.sh OUT_DIR --split tune   # only the voices held out for decisions
+#   scripts/fetch-real-speech.sh OUT_DIR --split networks  # only the networks' extra speakers
 #
 # Packages are fetched with `apt-get download` and unpacked with `dpkg -x` into a cache
 # ($REAL_SPEECH_CACHE, default build/real-speech-cache): no root needed, nothing installed, and
@@ -17,7 +19,7 @@
 # Exit codes: 0 done, 1 error, 2 usage, 77 the packages or tools cannot be had (tests skip).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
-out="${1:?usage: fetch-real-speech.sh OUT_DIR [--subset N] [--split train|dev|tune]}"
+out="${1:?usage: fetch-real-speech.sh OUT_DIR [--subset N] [--split train|networks|dev|tune]}"
 shift
 cache="${REAL_SPEECH_CACHE:-$here/build/real-speech-cache}"
 

@@ -46,7 +46,7 @@ done
 left_out=(klettres-en-gb asterisk-en-allison)
 
 if [ "$fetch" = 1 ]; then
-  for split in train tune $([ "$dev" = 1 ] && echo dev); do
+  for split in train networks tune $([ "$dev" = 1 ] && echo dev); do
     "$here/scripts/fetch-real-speech.sh" "$real" --split "$split" ||
       { echo "held-out-check.sh: fetching the $split speakers failed" >&2; exit 1; }
   done

@@ -74,8 +74,8 @@ def load_speakers(path):
         if not line:
             continue
         fields = line.split()
-        if len(fields) != 3 or fields[1] not in ("train", "dev", "tune"):
-            sys.exit(f"{path}:{n}: expected 'SPEAKER train|dev|tune SOURCE', got '{line}'")
+        if len(fields) != 3 or fields[1] not in ("train", "networks", "dev", "tune"):
+            sys.exit(f"{path}:{n}: expected 'SPEAKER train|networks|dev|tune SOURCE', got '{line}'")
         speakers.append(tuple(fields))
     return speakers
 
@@ -525,7 +525,7 @@ def main():
     ap.add_argument("root", type=Path)
     ap.add_argument("out", type=Path)
     ap.add_argument("--subset", type=int, default=0, help="only the first N items per speaker")
-    ap.add_argument("--split", default="", help="only this split (train, dev or tune)")
+    ap.add_argument("--split", default="", help="only this split (train, networks, dev or tune)")
     args = ap.parse_args()
     speakers = load_speakers(HERE / "config/corpus/real-speakers.txt")
     arpabet = load_map("arpabet")

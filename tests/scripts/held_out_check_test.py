@@ -14,6 +14,10 @@ CHECK = ROOT / "scripts" / "held-out-check.sh"
 TRAIN = ROOT / "scripts" / "train-templates.sh"
 TRAINING_SPEAKERS = ["asterisk-en-allison", "klettres-en-gb", "asterisk-it-carlo",
                      "asterisk-es-allison"]
+# Speakers in the networks only (config/corpus/real-speakers.txt's `networks` split).
+NETWORK_SPEAKERS = [line.split()[0] for line in
+                    (ROOT / "config/corpus/real-speakers.txt").read_text().splitlines()
+                    if not line.startswith("#") and line.split()[1:2] == ["networks"]]
 
 # The stand-in: logs every call; `say` writes files, `train` a set, `eval` figures in which a
 # speaker scored on the set trained without it reads 25 % and on any other set 75 %.
@@ -54,6 +58,8 @@ class HeldOutCheck(unittest.TestCase):
         self.real = self.root / "real"
         for speaker in TRAINING_SPEAKERS:
             (self.real / "train" / speaker).mkdir(parents=True)
+        for speaker in NETWORK_SPEAKERS:
+            (self.real / "networks" / speaker).mkdir(parents=True)
         for voice in ("asterisk-ru-f", "fillets-cs-v"):
             (self.real / "tune" / voice).mkdir(parents=True)
         self.env = dict(os.environ, LIPSYNC=str(self.fake), FAKE_LOG=str(self.log),
@@ -87,6 +93,15 @@ class HeldOutCheck(unittest.TestCase):
         self.assertEqual(len(full), 1, trainings)
         for speaker in TRAINING_SPEAKERS:
             self.assertIn(f"/train/{speaker} ", full[0] + " ")
+        # The networks-only speakers are labelled by the aligner and go into the networks of
+        # every set, never into its templates.
+        networks = [c for c in self.log.read_text().splitlines()
+                    if c.startswith("train ") and "--keep-templates" in c and "all.json" in c]
+        self.assertEqual(len(networks), 1)
+        self.assertTrue(NETWORK_SPEAKERS)
+        for speaker in NETWORK_SPEAKERS:
+            self.assertIn(f"/aligned/{speaker} ", networks[0] + " ")
+            self.assertNotIn(f"/{speaker} ", full[0] + " ")
         for voice in ("asterisk-ru-f", "fillets-cs-v"):
             lines = [l for l in result.stdout.splitlines() if l.strip().startswith(voice + ",")]
             self.assertEqual(len(lines), 2, result.stdout)

@@ -135,7 +135,7 @@ class SpeakerList(unittest.TestCase):
 
     def test_the_shipped_list_has_every_split(self):
         speakers = labeller.load_speakers(SCRIPT.parent.parent / "config/corpus/real-speakers.txt")
-        self.assertEqual({split for _, split, _ in speakers}, {"train", "dev", "tune"})
+        self.assertEqual({split for _, split, _ in speakers}, {"train", "networks", "dev", "tune"})
 
     def test_a_tune_voice_is_read_with_its_source(self):
         self.assertEqual(self.load("# a comment\nfillets-cs-v  tune  fillets:cs:v  # the fish\n"),
@@ -144,7 +144,7 @@ class SpeakerList(unittest.TestCase):
     def test_an_unknown_split_names_the_line(self):
         with self.assertRaises(SystemExit) as raised:
             self.load("klettres-en  dev  klettres:en\nsomeone  test  klettres:en\n")
-        self.assertIn(":2: expected 'SPEAKER train|dev|tune SOURCE'", str(raised.exception))
+        self.assertIn(":2: expected 'SPEAKER train|networks|dev|tune SOURCE'", str(raised.exception))
 
 
 class WriteLab(unittest.TestCase):
