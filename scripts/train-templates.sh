@@ -14,6 +14,9 @@
 #   scripts/train-templates.sh --networks-only  # keep the shipped templates, retrain the networks
 #   scripts/train-templates.sh --channel-normalised  # the opt-in channel-normalised set instead:
 #                                               # config/templates/channel-normalised.json
+#                                               # (shipped with networks from before the
+#                                               # `networks` speakers and 64 units; this retrains
+#                                               # them the way below)
 # and, to judge a change before it is shipped (scripts/held-out-check.sh does this):
 #   --leave-out SPEAKER   train without this real training speaker (repeatable), so that it can
 #                         be scored as a voice the set has never heard
