@@ -9,6 +9,7 @@
 #include <lipsyncd/dsp.hpp>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "ExpectRejected.hpp"
 
@@ -211,15 +212,17 @@ TEST(ClassNetwork, TravelsWithTheTemplatesAndIsValidated) {
     test::expectRejected(bad, "class_network.classes[1]: 'aa' listed twice");
 }
 
-// The output layer is summed eight classes at a time: every class's scaled likelihood must be
-// exactly the plain sum over the units in order, silent (rectified) units adding nothing and a
-// unit that is not a number counting as silent, whatever the number of classes (fewer than a
-// block, a whole block, and blocks that overlap at the end).
+// Both layers are summed eight units or classes at a time: every class's scaled likelihood must
+// be exactly the plain sums in order, feature by feature into each unit and unit by unit into
+// each class, silent (rectified) units adding nothing and a unit that is not a number counting
+// as silent, whatever the numbers of units and classes (fewer than a block, a whole block, and
+// blocks that overlap at the end).
 TEST(ClassNetwork, EachClassIsTheSumOverItsUnitsWhateverTheBlocks) {
     std::mt19937 rng(11);
     std::normal_distribution<float> value(0, 1);
-    const std::size_t features = 5, units = 13;
-    for (const std::size_t count : {3u, 8u, 22u}) {
+    const std::size_t features = 5;
+    for (const auto& [units, count] :
+         {std::pair<std::size_t, std::size_t>{13, 3}, {13, 8}, {13, 22}, {5, 22}, {16, 9}}) {
         ClassNetwork net;
         net.inputMean.assign(features, 0.5f);
         net.inputScale.assign(features, 2.0f);
