@@ -226,6 +226,8 @@ def main():
         fields = line.split("#", 1)[0].split()
         if len(fields) == 3 and (args.real / fields[1] / fields[0]).is_dir():
             speaker, split = fields[0], fields[1]
+            if split == "networks":  # words only: their labels are the aligner's (train-templates.sh)
+                continue
             # Only train speakers train (tune voices are held out like dev ones).
             (training if split == "train" and speaker not in LEFT_OUT else scored).append(
                 args.real / split / speaker)
