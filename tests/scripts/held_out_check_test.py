@@ -2,6 +2,7 @@
 """scripts/held-out-check.sh and train-templates.sh's --leave-out, with a stand-in for the
 lipsync tool (no speech, no training): a speaker left out is trained without and scored on the
 set trained without it, the held-out voices on the full set, and bad arguments are refused."""
+import importlib.util
 import json
 import os
 import subprocess
@@ -14,10 +15,15 @@ CHECK = ROOT / "scripts" / "held-out-check.sh"
 TRAIN = ROOT / "scripts" / "train-templates.sh"
 TRAINING_SPEAKERS = ["asterisk-en-allison", "klettres-en-gb", "asterisk-it-carlo",
                      "asterisk-es-allison"]
-# Speakers in the networks only (config/corpus/real-speakers.txt's `networks` split).
-NETWORK_SPEAKERS = [line.split()[0] for line in
-                    (ROOT / "config/corpus/real-speakers.txt").read_text().splitlines()
-                    if not line.startswith("#") and line.split()[1:2] == ["networks"]]
+# Speakers in the networks only (config/corpus/real-speakers.txt's `networks` split), read as
+# the labeller reads the list.
+_spec = importlib.util.spec_from_file_location("label_real_speech",
+                                               ROOT / "scripts" / "label-real-speech.py")
+_labeller = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_labeller)
+NETWORK_SPEAKERS = [speaker for speaker, split, _ in
+                    _labeller.load_speakers(ROOT / "config/corpus/real-speakers.txt")
+                    if split == "networks"]
 
 # The stand-in: logs every call; `say` writes files, `train` a set, `eval` figures in which a
 # speaker scored on the set trained without it reads 25 % and on any other set 75 %.
