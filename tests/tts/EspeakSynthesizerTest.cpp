@@ -113,10 +113,10 @@ std::vector<std::string> classesOf(const std::string& text, const std::string& v
     return out;
 }
 
-// French, Spanish, Bulgarian, Romanian, Czech and Dutch lines are said and aligned through their
-// own maps (config/phonemes/espeak-fr.toml, -es, -bg, -ro, -cs, -nl): the lips close for m, b and
-// p, meet the teeth for f and v, round for ou and u, and the jaw opens for a, whatever the
-// language's own letters.
+// French, Spanish, Bulgarian, Romanian, Czech, Dutch, Catalan, Belarusian, Greek and Danish lines
+// are said and aligned through their own maps (config/phonemes/espeak-fr.toml, -es, -bg, -ro,
+// -cs, -nl, -ca, -be, -el, -da): the lips close for m, b and p, meet the teeth for f and v, round
+// for ou and u, and the jaw opens for a, whatever the language's own letters.
 TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
     EXPECT_EQ(classesOf("Bonjour, ma petite fille.", "fr", 1),
               (std::vector<std::string>{"bmp", "ah"}));
@@ -143,6 +143,27 @@ TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
     EXPECT_EQ(classesOf("wang", "nl", 0),  // w: the lower lip to the teeth
               (std::vector<std::string>{"f", "aa", "d"}));
     EXPECT_EQ(classesOf("goed", "nl", 0), (std::vector<std::string>{"kg", "w", "d"}));
+    EXPECT_EQ(classesOf("La mare menja pa.", "ca", 1),  // m a ** @
+              (std::vector<std::string>{"bmp", "aa", "r", "er"}));
+    EXPECT_EQ(classesOf("vaca", "ca", 0),  // v: the lower lip to the teeth
+              (std::vector<std::string>{"f", "aa", "kg", "ah"}));
+    EXPECT_EQ(classesOf("lluna", "ca", 0), (std::vector<std::string>{"sh", "w", "d", "ah"}));
+    EXPECT_EQ(classesOf("Мама п'е малако.", "be", 0),
+              (std::vector<std::string>{"bmp", "ah", "bmp", "ah"}));
+    EXPECT_EQ(classesOf("вуха", "be", 0), (std::vector<std::string>{"f", "w", "kg", "ah"}));
+    EXPECT_EQ(classesOf("Ο μπαμπάς μου.", "el", 1),  // μπ is b
+              (std::vector<std::string>{"bmp", "aa", "bmp", "aa", "z"}));
+    EXPECT_EQ(classesOf("βουνό", "el", 0), (std::vector<std::string>{"f", "w", "d", "ow"}));
+    EXPECT_EQ(classesOf("θέλω", "el", 0),  // θ: the tongue at the teeth, not the lips
+              (std::vector<std::string>{"th", "eh", "l", "ow"}));
+    EXPECT_EQ(classesOf("Mor og far.", "da", 2), (std::vector<std::string>{"f", "aa"}));
+    EXPECT_EQ(classesOf("blå bøf", "da", 1),  // ø: the lips round
+              (std::vector<std::string>{"bmp", "ow", "f"}));
+    EXPECT_EQ(classesOf("hus", "da", 0), (std::vector<std::string>{"h", "w", "z"}));
+    // Russian numbers: espeak-ng's r of три and четыре (R;) and the tap of сорок (*).
+    EXPECT_EQ(classesOf("3", "ru", 0), (std::vector<std::string>{"d", "r", "ih"}));
+    EXPECT_EQ(classesOf("сорок", "ru", 0),  // s V r o k
+              (std::vector<std::string>{"z", "ah", "r", "ao", "kg"}));
 }
 
 // French espeak-ng says "tout le monde" as one dictionary entry, one word event whose length
