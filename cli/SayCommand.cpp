@@ -51,10 +51,10 @@ void addSayCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "say", "Speak TEXT with espeak-ng; write the speech and its exact phoneme schedule");
     cmd->add_option("text", o->text, "What to say")->required();
-    cmd->add_option(
-           "--voice", o->voice,
-           "espeak-ng voice, variants with '+' (en-us+f2); its language needs a "
-           "phoneme map, config/phonemes/espeak-LANG.toml (en, fr, es, ru, bg, ro, cs, nl, ca, be, el, da)")
+    cmd->add_option("--voice", o->voice,
+                    "espeak-ng voice, variants with '+' (en-us+f2); its language needs a "
+                    "phoneme map, config/phonemes/espeak-LANG.toml (en, fr, es, ru, bg, ro, cs, "
+                    "nl, ca, be, el, da)")
         ->capture_default_str();
     cmd->add_option("--rate", o->rate, "Words per minute (default: the voice's)")
         ->check(CLI::Range(80, 450));
