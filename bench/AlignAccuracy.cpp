@@ -79,7 +79,8 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"skipWordCost", &dsp::AlignerConfig::skipWordCost},
         {"reductionCost", &dsp::AlignerConfig::reductionCost},
         {"beam", &dsp::AlignerConfig::beam},
-        {"fileAdaptationPriorFrames", &dsp::AlignerConfig::fileAdaptationPriorFrames}};
+        {"fileAdaptationPriorFrames", &dsp::AlignerConfig::fileAdaptationPriorFrames},
+        {"classNetworkShare", &dsp::AlignerConfig::classNetworkShare}};
     const std::map<std::string, double dsp::AlignerConfig::*> doubles = {
         {"minVowelSeconds", &dsp::AlignerConfig::minVowelSeconds},
         {"minPauseSeconds", &dsp::AlignerConfig::minPauseSeconds},

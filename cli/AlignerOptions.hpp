@@ -43,6 +43,12 @@ struct AlignerOptions {
                             "frames (0: one pass)"))
             ->check(CLI::Range(0.0, 1000.0))
             ->capture_default_str();
+        cmd.add_option("--class-network-share", config.classNetworkShare,
+                       help("how much of the class network's term (and the class bias) the "
+                            "aligner weighs beside the templates' distances (0: the templates "
+                            "alone)"))
+            ->check(CLI::Range(0.0, 1.0))
+            ->capture_default_str();
         cmd.add_flag("!--no-reductions", reductions,
                      help("follow espeak-ng's reading only, without the common reductions "
                           "(config/reductions/LANG.toml: weak forms, t/d and schwa deletion)"));

@@ -30,6 +30,26 @@ constexpr double kMinTimeScale = 0.5, kMaxTimeScale = 2.0;
 // Audio shorter than this fraction of the script's minimum cannot hold the words.
 constexpr double kTooShortFraction = 0.8;
 
+// What the class network and the set's class bias add to a frame's template distances
+// (FrameClassifier::distances() over templateDistances()), per class; 0 where either is not
+// finite (a class without templates keeps its distance as the templates give it).
+void networkTerm(std::span<const float> templates, std::span<const float> full,
+                 std::span<float> term) {
+    for (std::size_t c = 0; c < term.size(); ++c)
+        term[c] =
+            std::isfinite(templates[c]) && std::isfinite(full[c]) ? full[c] - templates[c] : 0.0f;
+}
+
+// The distances the aligner weighs: the templates', plus `share` of the network's term
+// (AlignerConfig::classNetworkShare).
+std::span<const float> withNetworkShare(std::span<const float> templates,
+                                        std::span<const float> term, float share,
+                                        std::vector<float>& out) {
+    out.resize(templates.size());
+    for (std::size_t c = 0; c < templates.size(); ++c) out[c] = templates[c] + share * term[c];
+    return out;
+}
+
 double scriptSeconds(std::span<const ScriptWord> script) {
     double total = 0;
     for (const auto& w : script)
@@ -177,28 +197,31 @@ PhonemeSchedule placedSegments(const Alignment& a) {
     return placed;
 }
 
-// The frames a second pass needs, with the first pass's gate and its distances per block of
-// templates (FrameClassifier::blockDistances()), up to a bound (about 740 bytes a frame: 22 MB
-// for AlignerConfig::fileAdaptationMaxSeconds).
+// The frames a second pass needs, with the first pass's gate, its distances per block of
+// templates (FrameClassifier::blockDistances()) and the class network's term (networkTerm), up
+// to a bound (about 830 bytes a frame: 25 MB for AlignerConfig::fileAdaptationMaxSeconds).
 class KeptFrames {
   public:
     explicit KeptFrames(std::size_t limit) : limit_(limit) {}
     // Room for the frames expected, so that they are not copied as the arrays grow.
-    void reserve(std::size_t frames, std::size_t blocksPerFrame) {
+    void reserve(std::size_t frames, std::size_t blocksPerFrame, std::size_t classes) {
         frames = std::min(frames, limit_);
         frames_.reserve(frames);
         silent_.reserve(frames);
         blocks_.reserve(frames * blocksPerFrame);
+        terms_.reserve(frames * classes);
     }
-    void add(const FrameFeatures& frame, bool silent, std::span<const float> blocks) {
+    void add(const FrameFeatures& frame, bool silent, std::span<const float> blocks,
+             std::span<const float> term) {
         if (frames_.size() >= limit_) {
             overflow_ = true;
             return;
         }
-        if (frames_.empty()) blocksPerFrame_ = blocks.size();
+        if (frames_.empty()) blocksPerFrame_ = blocks.size(), classes_ = term.size();
         frames_.push_back(frame);
         silent_.push_back(silent);
         blocks_.insert(blocks_.end(), blocks.begin(), blocks.end());
+        terms_.insert(terms_.end(), term.begin(), term.end());
     }
     bool complete() const { return limit_ > 0 && !overflow_; }
     std::span<const FrameFeatures> frames() const { return frames_; }
@@ -206,19 +229,24 @@ class KeptFrames {
     std::span<const float> blocks(std::size_t frame) const {
         return std::span(blocks_).subspan(frame * blocksPerFrame_, blocksPerFrame_);
     }
+    std::span<const float> term(std::size_t frame) const {
+        return std::span(terms_).subspan(frame * classes_, classes_);
+    }
 
   private:
     std::size_t limit_;
     bool overflow_ = false;
     std::vector<FrameFeatures> frames_;
     std::vector<std::uint8_t> silent_;
-    std::size_t blocksPerFrame_ = 0;
+    std::size_t blocksPerFrame_ = 0, classes_ = 0;
     std::vector<float> blocks_;  // [frame][block]
+    std::vector<float> terms_;   // [frame][class]
 };
 
 // The second pass (AlignerConfig::fileAdaptationPriorFrames, Gauvain & Lee 1994): the file's
 // frames again, on templates moved toward what the first pass placed (`measured`: the set the
-// first pass classified with). The energy gate is the first pass's: it depends on the frames'
+// first pass classified with), with the first pass's share of the class network's term (it
+// depends on the frame alone). The energy gate is the first pass's: it depends on the frames'
 // levels alone. The first pass's verdict on each word stands: a word it left unplaced stays so,
 // whatever the moved templates say (they learnt from the placed words only, and would fit a
 // wrong script better the second time).
@@ -230,8 +258,16 @@ Alignment realign(const Alignment& first, const SpeakerAdaptation& own, const Ke
     ForcedAligner aligner(script, set, adapted.analysis.hopSeconds, timeScale, config);
     const auto frames = kept.frames();
     aligner.expectFrames(static_cast<std::int64_t>(frames.size()));
-    for (std::size_t i = 0; i < frames.size(); ++i)
-        aligner.push(frames[i].time, distances(frames[i], kept.blocks(i)), kept.silent()[i]);
+    std::vector<float> mixed;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        const auto d = distances(frames[i], kept.blocks(i));
+        if (config.classNetworkShare > 0)
+            aligner.push(frames[i].time,
+                         withNetworkShare(d, kept.term(i), config.classNetworkShare, mixed),
+                         kept.silent()[i], d);
+        else
+            aligner.push(frames[i].time, d, kept.silent()[i]);
+    }
     auto second = aligner.finish();
     if (!second.complete || second.words.size() != first.words.size()) return first;
     for (std::size_t i = 0; i < second.words.size(); ++i)
@@ -267,13 +303,22 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
                              : 0);
     if (adapting) analyzer.recordBlockDistances();
     const auto room = static_cast<std::size_t>(expected) + 2;
-    kept.reserve(room, analyzer.blockDistances().size());
+    kept.reserve(room, analyzer.blockDistances().size(), set.size());
     r.levels.db.reserve(room);
     r.levels.jaw.reserve(room);
     std::size_t speechFrames = 0;
+    const float share = alignerConfig.classNetworkShare;
+    std::vector<float> term(share > 0 ? set.size() : 0), mixed(term.size());
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
-        if (adapting) kept.add(f.features, f.label.silent, analyzer.blockDistances());
-        aligner.push(f.label.time, analyzer.templateDistances(), f.label.silent);
+        const auto templates = analyzer.templateDistances();
+        if (share > 0) {
+            networkTerm(templates, analyzer.distances(), term);
+            aligner.push(f.label.time, withNetworkShare(templates, term, share, mixed),
+                         f.label.silent, templates);
+        } else {
+            aligner.push(f.label.time, templates, f.label.silent);
+        }
+        if (adapting) kept.add(f.features, f.label.silent, analyzer.blockDistances(), term);
         speechFrames += !f.label.silent;
         r.levels.add(f.label.time, f.label.energyDb);
         r.levels.jaw.push_back(f.label.jaw);  // the heard jaw, at the aligned share

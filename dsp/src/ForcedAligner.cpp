@@ -1,5 +1,6 @@
 // Forced alignment by frame-synchronous Viterbi on the classifier's distances (the templates'
-// distances read as negative log-likelihoods: Rabiner 1989, section III.B), beam-pruned, with
+// distances read as negative log-likelihoods: Rabiner 1989, section III.B; alignFile adds a share
+// of the class network's scaled likelihoods, Bourlard & Morgan 1994), beam-pruned, with
 // the path committed in windows: every commitSeconds, the best path is traced back and the
 // part older than lookaheadSeconds becomes final; paths that disagree with it there are
 // dropped, so what was committed is never contradicted later.
@@ -75,7 +76,8 @@ struct ForcedAligner::State {
         std::size_t back, excess;  // offsets into back_, excess_
     };
 
-    void scoreFrame(std::span<const float> distances, bool silent, std::vector<float>& excess);
+    void scoreFrame(std::span<const float> distances, std::span<const float> confidenceDistances,
+                    bool silent, std::vector<float>& excess);
     void step();
     int ancestor(std::int64_t frame, int node, std::int64_t atFrame) const;
     void ancestors(std::int64_t frame, std::span<int> nodes, std::int64_t atFrame) const;
@@ -103,32 +105,49 @@ struct ForcedAligner::State {
     bool finished = false;
 };
 
-void ForcedAligner::State::scoreFrame(std::span<const float> distances, bool silent,
-                                      std::vector<float>& excessOut) {
-    const auto emission = sweep.classCosts();
-    const std::size_t classes = set->size();
+namespace {
+// The least finite distance of a frame (kNever: none).
+float nearestOf(std::span<const float> distances, std::size_t classes) {
     float nearest = kNever;
     for (std::size_t c = 0; c < classes && c < distances.size(); ++c)
         if (std::isfinite(distances[c])) nearest = std::min(nearest, distances[c]);
+    return nearest;
+}
+
+// How far a class lies beyond the nearest (kMissingClassDb for one without a distance).
+float excessOf(std::span<const float> distances, std::size_t c, float nearest) {
+    if (!std::isfinite(nearest)) return 0;
+    const float d = c < distances.size() ? distances[c] : kNever;
+    return std::isfinite(d) ? d - nearest : kMissingClassDb;
+}
+}  // namespace
+
+void ForcedAligner::State::scoreFrame(std::span<const float> distances,
+                                      std::span<const float> confidenceDistances, bool silent,
+                                      std::vector<float>& excessOut) {
+    const auto emission = sweep.classCosts();
+    const std::size_t classes = set->size();
+    if (confidenceDistances.empty()) confidenceDistances = distances;
+    const float nearest = nearestOf(distances, classes);
+    const float nearestForConfidence = nearestOf(confidenceDistances, classes);
     const auto sil = set->silence();
     for (std::size_t c = 0; c < classes; ++c) {
-        const float d = c < distances.size() ? distances[c] : kNever;
-        float ex = 0;
-        if (std::isfinite(nearest)) ex = std::isfinite(d) ? d - nearest : kMissingClassDb;
+        const float ex = excessOf(distances, c, nearest);
+        float shown = excessOf(confidenceDistances, c, nearestForConfidence);
         float cost = config.distanceWeight * ex * (ex + 2 * (std::isfinite(nearest) ? nearest : 0));
         if (silent || !std::isfinite(nearest)) {  // below the gate, or no spectrum at all
             if (c == sil) {
-                cost = ex = 0;
+                cost = shown = 0;
             } else {
                 cost +=
                     (*set)[c].vowel ? config.speechInSilenceCost : config.consonantInSilenceCost;
-                ex += kSilentExcessDb;
+                shown += kSilentExcessDb;
             }
         } else if (c == sil) {
             cost += config.silenceInSpeechCost;
         }
         emission[c] = cost;
-        excessOut.push_back(ex);
+        excessOut.push_back(shown);
     }
     sweep.setSilent(silent);
 }
@@ -255,11 +274,12 @@ ForcedAligner::ForcedAligner(ForcedAligner&&) noexcept = default;
 ForcedAligner& ForcedAligner::operator=(ForcedAligner&&) noexcept = default;
 ForcedAligner::~ForcedAligner() = default;
 
-void ForcedAligner::push(double time, std::span<const float> distances, bool silent) {
+void ForcedAligner::push(double time, std::span<const float> distances, bool silent,
+                         std::span<const float> confidenceDistances) {
     auto& s = *state_;
     if (s.finished) throw std::logic_error("ForcedAligner::push after finish");
     s.rows.push_back({time, 0, 0, s.back.size(), s.excess.size()});
-    s.scoreFrame(distances, silent, s.excess);
+    s.scoreFrame(distances, confidenceDistances, silent, s.excess);
     s.step();
     ++s.frames;
     s.peakRows = std::max(s.peakRows, s.rows.size());

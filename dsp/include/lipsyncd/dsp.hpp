@@ -401,9 +401,10 @@ class FrameClassifier {
     // Valid after classify().
     std::span<const float> distances() const { return distances_; }
     // The templates' distances alone, without the class network's term or the class bias: what
-    // the forced aligner weighs (with the words known, the network's term moved boundaries away
-    // from the reference ones on the real training speakers left out of it: visual groups
-    // 84.9 / 53.5 % → 80.8 / 51.1 % for klettres-en-gb / asterisk-en-allison).
+    // the forced aligner weighs, with a share of the rest (AlignerConfig::classNetworkShare; all
+    // of the network's term moved boundaries away from the reference ones on the real training
+    // speakers left out of it: visual groups 84.9 / 53.5 % → 80.8 / 51.1 % for klettres-en-gb /
+    // asterisk-en-allison).
     std::span<const float> templateDistances() const {
         return templateDistances_.empty() ? distances_ : std::span<const float>(templateDistances_);
     }
@@ -427,7 +428,7 @@ class FrameClassifier {
     std::optional<JawNetwork> jawNetwork_;
     void addClassNetwork(const FrameFeatures& frame);
     std::optional<ClassNetwork> classNetwork_;
-    std::vector<int> networkClass_;                 // per network output: its set index (-1: none)
+    std::vector<int> networkClass_;  // per network output: its set index (-1: none)
     void addClassBias();
     std::vector<float> classBias_;  // per class, dB (TemplateSet::classBiasDb); empty: none
     std::vector<float> likelihoods_, hiddenUnits_;  // the class network's, per frame
@@ -895,6 +896,21 @@ struct AlignerConfig {
     // of the templates the next line starts from. Chosen on the same speakers, each line
     // adapting the next (10 / 30 / 100 frames: 87.9 / 89.4 / 89.3 % and 59.3 / 59.2 / 59.3 %).
     float speakerAdaptationPriorFrames = 30.0f;
+    // How much of what the class network and the set's class bias add to the templates'
+    // distances (FrameClassifier::distances() over templateDistances()) the aligner weighs too,
+    // 0..1 (0: the templates alone). The network has heard far more people than the templates
+    // (the `networks` speakers of config/corpus/real-speakers.txt), and with the words known it
+    // still tells their sounds apart better. The words' confidences stay on the templates'
+    // distances (ForcedAligner::push): on espeak-ng speech, which the templates fit better than
+    // the network, the network's term lowered right words below the floor. Chosen on the six
+    // voices held out for decisions, aligned (`lipsync eval --align`, summed: visual groups,
+    // jaw r, closures caught, false closures): 0: 309.9, 3.84, 434.1, 59.0; 0.15: 319.9, 3.92;
+    // 0.25: 326.5, 3.95, 447.1, 55.2; 0.4: 330.9, 3.96, 455.1, 55.6; 0.6: 332.3, 3.97, 452.6,
+    // 55.7; 0.8: 331.9, 3.96, 451.5, 55.9. With each speaker's voice carried from line to line
+    // (--adapt-speaker) 0: 325.1, 3.93, 451.3, 52.0; 0.4: 342.7, 4.01, 469.2, 52.7. On the
+    // espeak-ng dev corpus (bench/align_accuracy) 0 and 0.4 alike: median 6.5 / 6.5 ms, p95
+    // 35.5 / 35.5 ms, within 20 ms 85.5 / 86.2 %, words placed 665 / 666 of 672.
+    float classNetworkShare = 0.4f;
 };
 
 struct AlignedWord {
@@ -973,8 +989,12 @@ class ForcedAligner {
     ~ForcedAligner();
 
     // One frame: its centre time, the classifier's distance to each class (+inf: no template
-    // or no spectrum) and whether it is below the energy gate.
-    void push(double time, std::span<const float> distances, bool silent);
+    // or no spectrum) and whether it is below the energy gate. `confidenceDistances`, when not
+    // empty, are what the words' confidences are measured on instead (the templates' own, when
+    // `distances` carry the class network's share: its term lowered right words' confidence on
+    // voices it fits less well than the templates do, and left them unplaced).
+    void push(double time, std::span<const float> distances, bool silent,
+              std::span<const float> confidenceDistances = {});
     // The input's length in frames, when known before the end (a file). The path is committed
     // in windows, each time from the best partial path; knowing the length, a commit passes
     // over partial paths that can no longer fit the rest of the words in the frames left. A
