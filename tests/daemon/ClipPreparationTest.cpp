@@ -61,15 +61,21 @@ TEST(ClipPreparation, TheQueueIsBounded) {
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
     int accepted = 0;
-    json last;
+    json refused;
     for (int i = 0; i < 5; ++i) {
-        last = c.request({{"cmd", "say"}, {"text", "Number " + std::to_string(i) + "."}});
-        accepted += last["ok"].get<bool>();
+        const auto reply =
+            c.request({{"cmd", "say"}, {"text", "Number " + std::to_string(i) + "."}});
+        if (reply["ok"].get<bool>())
+            ++accepted;
+        else
+            refused = reply;
     }
-    // Two wait, one may already play: never all five.
+    // Two wait, one may already play: never all five. Which ones are refused depends on when
+    // the first line, prepared on the worker, starts to play and leaves the queue (on a loaded
+    // machine the fifth found room after the third and fourth were refused).
     EXPECT_LE(accepted, 3);
-    EXPECT_EQ(last["ok"], false);
-    EXPECT_NE(errorOf(last).find("queue full"), std::string::npos) << last;
+    ASSERT_FALSE(refused.is_null()) << "all five accepted";
+    EXPECT_NE(errorOf(refused).find("queue full"), std::string::npos) << refused;
     EXPECT_EQ(d.stop(), 0);
 }
 
