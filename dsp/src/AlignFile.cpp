@@ -303,12 +303,12 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
                              : 0);
     if (adapting) analyzer.recordBlockDistances();
     const auto room = static_cast<std::size_t>(expected) + 2;
-    kept.reserve(room, analyzer.blockDistances().size(), set.size());
+    const float share = alignerConfig.classNetworkShare;
+    std::vector<float> term(share > 0 ? set.size() : 0), mixed(term.size());
+    kept.reserve(room, analyzer.blockDistances().size(), term.size());
     r.levels.db.reserve(room);
     r.levels.jaw.reserve(room);
     std::size_t speechFrames = 0;
-    const float share = alignerConfig.classNetworkShare;
-    std::vector<float> term(share > 0 ? set.size() : 0), mixed(term.size());
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
         const auto templates = analyzer.templateDistances();
         if (share > 0) {
