@@ -40,14 +40,18 @@ void networkTerm(std::span<const float> templates, std::span<const float> full,
             std::isfinite(templates[c]) && std::isfinite(full[c]) ? full[c] - templates[c] : 0.0f;
 }
 
-// The distances the aligner weighs: the templates', plus `share` of the network's term
-// (AlignerConfig::classNetworkShare).
-std::span<const float> withNetworkShare(std::span<const float> templates,
-                                        std::span<const float> term, float share,
-                                        std::vector<float>& out) {
-    out.resize(templates.size());
-    for (std::size_t c = 0; c < templates.size(); ++c) out[c] = templates[c] + share * term[c];
-    return out;
+// One frame into the aligner: the templates' distances, plus `share` of the network's term
+// (AlignerConfig::classNetworkShare) when it is on; the words' confidences then stay on the
+// templates' own (ForcedAligner::push). `mixed` is room for the sum.
+void pushFrame(ForcedAligner& aligner, double time, std::span<const float> templates,
+               std::span<const float> term, float share, bool silent, std::vector<float>& mixed) {
+    if (share <= 0) {
+        aligner.push(time, templates, silent);
+        return;
+    }
+    mixed.resize(templates.size());
+    for (std::size_t c = 0; c < templates.size(); ++c) mixed[c] = templates[c] + share * term[c];
+    aligner.push(time, mixed, silent, templates);
 }
 
 double scriptSeconds(std::span<const ScriptWord> script) {
@@ -259,15 +263,9 @@ Alignment realign(const Alignment& first, const SpeakerAdaptation& own, const Ke
     const auto frames = kept.frames();
     aligner.expectFrames(static_cast<std::int64_t>(frames.size()));
     std::vector<float> mixed;
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-        const auto d = distances(frames[i], kept.blocks(i));
-        if (config.classNetworkShare > 0)
-            aligner.push(frames[i].time,
-                         withNetworkShare(d, kept.term(i), config.classNetworkShare, mixed),
-                         kept.silent()[i], d);
-        else
-            aligner.push(frames[i].time, d, kept.silent()[i]);
-    }
+    for (std::size_t i = 0; i < frames.size(); ++i)
+        pushFrame(aligner, frames[i].time, distances(frames[i], kept.blocks(i)), kept.term(i),
+                  config.classNetworkShare, kept.silent()[i], mixed);
     auto second = aligner.finish();
     if (!second.complete || second.words.size() != first.words.size()) return first;
     for (std::size_t i = 0; i < second.words.size(); ++i)
@@ -311,13 +309,8 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
     std::size_t speechFrames = 0;
     analyzer.onFrame([&](const StreamingAnalyzer::Frame& f) {
         const auto templates = analyzer.templateDistances();
-        if (share > 0) {
-            networkTerm(templates, analyzer.distances(), term);
-            aligner.push(f.label.time, withNetworkShare(templates, term, share, mixed),
-                         f.label.silent, templates);
-        } else {
-            aligner.push(f.label.time, templates, f.label.silent);
-        }
+        if (share > 0) networkTerm(templates, analyzer.distances(), term);
+        pushFrame(aligner, f.label.time, templates, term, share, f.label.silent, mixed);
         if (adapting) kept.add(f.features, f.label.silent, analyzer.blockDistances(), term);
         speechFrames += !f.label.silent;
         r.levels.add(f.label.time, f.label.energyDb);
