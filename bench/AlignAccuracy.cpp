@@ -12,7 +12,8 @@
 // name=value sets an AlignerConfig field (see kFields) for tuning, which is done on the
 // training corpus, never on dev. A reference boundary is matched with the nearest aligned
 // boundary between the same two classes; one with no such partner within 100 ms is "missed"
-// and counted at 100 ms in the percentiles.
+// and counted at 100 ms in the percentiles (dsp::scoreBoundaries, which `lipsync eval --align`
+// reports per speaker too).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -28,40 +29,6 @@ namespace {
 
 using namespace lipsyncd;
 namespace fs = std::filesystem;
-
-constexpr double kMissedSeconds = 0.1;
-
-struct Boundary {
-    double time;
-    std::string left, right;
-};
-
-std::vector<Boundary> boundaries(const PhonemeSchedule& s) {
-    std::vector<Boundary> out;
-    for (std::size_t i = 1; i < s.size(); ++i)
-        if (s[i].phoneme != s[i - 1].phoneme)
-            out.push_back({s[i].start, s[i - 1].phoneme, s[i].phoneme});
-    return out;
-}
-
-std::vector<double> boundaryErrors(const PhonemeSchedule& hyp, const PhonemeSchedule& ref) {
-    const auto h = boundaries(hyp);
-    std::vector<double> errors;
-    for (const auto& r : boundaries(ref)) {
-        double best = kMissedSeconds;
-        for (const auto& b : h)
-            if (b.left == r.left && b.right == r.right)
-                best = std::min(best, std::abs(b.time - r.time));
-        errors.push_back(best);
-    }
-    return errors;
-}
-
-double percentile(std::vector<double> v, double p) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    return v[static_cast<std::size_t>(std::min<double>(v.size() - 1, p * (v.size() - 1) + 0.5))];
-}
 
 void set(dsp::AlignerConfig& c, const std::string& assignment) {
     const auto eq = assignment.find('=');
@@ -140,7 +107,7 @@ int main(int argc, char** argv) {
     EspeakSynthesizer synth;
     const auto templates = templatesFile.empty() ? dsp::TemplateSet::loadDefault()
                                                  : dsp::TemplateSet::load(templatesFile);
-    std::vector<double> errors;
+    dsp::BoundaryScore boundaries;
     std::size_t words = 0, placed = 0;
     double audioSeconds = 0, cpuSeconds = 0;
     for (const auto& wav : files) {
@@ -152,21 +119,18 @@ int main(int argc, char** argv) {
             alignText(synth, wav, sentences.at(index), languageOf(wav), templates, {}, config);
         cpuSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         audioSeconds += r.durationSeconds;
-        const auto e = boundaryErrors(r.schedule, ref);
-        errors.insert(errors.end(), e.begin(), e.end());
+        boundaries.add(dsp::scoreBoundaries(r.schedule, ref));
         for (const auto& w : r.alignment.words) {
             ++words;
             placed += w.placed;
         }
     }
-    const auto missed = std::count(errors.begin(), errors.end(), kMissedSeconds);
-    std::cout << files.size() << " files, " << errors.size() << " boundaries, " << missed
-              << " missed; words placed " << placed << "/" << words << "\n"
-              << "median " << percentile(errors, 0.5) * 1000 << " ms, p90 "
-              << percentile(errors, 0.9) * 1000 << " ms, p95 " << percentile(errors, 0.95) * 1000
-              << " ms; within 20 ms "
-              << std::count_if(errors.begin(), errors.end(), [](double e) { return e <= 0.02; }) *
-                     100.0 / std::max<std::size_t>(1, errors.size())
+    std::cout << files.size() << " files, " << boundaries.errors.size() << " boundaries, "
+              << boundaries.missed << " missed; words placed " << placed << "/" << words << "\n"
+              << "median " << boundaries.percentile(0.5) * 1000 << " ms, p90 "
+              << boundaries.percentile(0.9) * 1000 << " ms, p95 "
+              << boundaries.percentile(0.95) * 1000 << " ms; within 20 ms "
+              << boundaries.shareWithin(0.02) * 100
               << " %\nspeed (whole pipeline incl. espeak-ng and decoding) "
               << audioSeconds / cpuSeconds << "x real time\n";
     bool ok = true;
@@ -174,8 +138,8 @@ int main(int argc, char** argv) {
         if (!pass) std::cerr << "align_accuracy: below the floor: " << what << '\n';
         ok = ok && pass;
     };
-    check(percentile(errors, 0.5) * 1000 <= maxMedianMs, "median boundary error");
-    check(percentile(errors, 0.95) * 1000 <= maxP95Ms, "95th percentile boundary error");
+    check(boundaries.percentile(0.5) * 1000 <= maxMedianMs, "median boundary error");
+    check(boundaries.percentile(0.95) * 1000 <= maxP95Ms, "95th percentile boundary error");
     check(static_cast<double>(placed) >= minPlaced, "words placed");
     check(!files.empty(), "no files in " + std::string(argv[1]));
     return ok ? 0 : 1;

@@ -53,7 +53,10 @@ struct JawScores {
 struct Score {
     dsp::ScheduleScore schedule;
     JawScores jaw;
-    void add(const Score& o) { schedule.add(o.schedule), jaw.add(o.jaw); }
+    dsp::BoundaryScore boundaries;  // with --align: the alignment's timing
+    void add(const Score& o) {
+        schedule.add(o.schedule), jaw.add(o.jaw), boundaries.add(o.boundaries);
+    }
 };
 
 struct Row {
@@ -164,6 +167,7 @@ struct Evaluator {
         const auto [hypothesis, levels] = schedule(item);
         Score s;
         s.schedule = dsp::scoreSchedule(hypothesis, reference, set);
+        if (o.align) s.boundaries = dsp::scoreBoundaries(hypothesis, reference);
         if (puppet && !reference.empty()) s.jaw = scoreJaws(item, reference, hypothesis, levels);
         return s;
     }
@@ -241,11 +245,21 @@ nlohmann::json jawJson(const lipsync::JawScore& j) {
             {"false_closures", j.falseClosureRate()}};
 }
 
-nlohmann::json scoreJson(const Score& s, bool jaw) {
+nlohmann::json boundaryJson(const dsp::BoundaryScore& b) {
+    return {{"count", b.errors.size()},
+            {"missed", b.missed},
+            {"median_ms", 1000 * b.percentile(0.5)},
+            {"p95_ms", 1000 * b.percentile(0.95)},
+            {"within_20ms", b.shareWithin(0.02)},
+            {"within_50ms", b.shareWithin(0.05)}};
+}
+
+nlohmann::json scoreJson(const Score& s, const EvalOptions& o) {
     nlohmann::json j{{"frames", s.schedule.frames},
                      {"accuracy", s.schedule.accuracy()},
                      {"group_accuracy", s.schedule.groupAccuracy()}};
-    if (jaw)
+    if (o.align) j["boundaries"] = boundaryJson(s.boundaries);
+    if (o.jaw)
         j["jaw"] = {{"audio", jawJson(s.jaw.audio)},
                     {"labels", jawJson(s.jaw.labels)},
                     {"envelope", jawJson(s.jaw.envelope)}};
@@ -259,20 +273,41 @@ struct Report {
 };
 
 nlohmann::json toJson(const Report& report, const PhonemeSet& set, const EvalOptions& o) {
-    auto j = scoreJson(report.total, o.jaw);
+    auto j = scoreJson(report.total, o);
     if (o.jaw) j["puppet"] = o.puppet;
     for (const auto& f : report.files) {
-        auto row = scoreJson(f.score, o.jaw);
+        auto row = scoreJson(f.score, o);
         row["name"] = f.name;
         row["speaker"] = f.speaker;
         j["files"].push_back(row);
     }
-    for (const auto& [name, s] : report.speakers) j["speakers"][name] = scoreJson(s, o.jaw);
+    for (const auto& [name, s] : report.speakers) j["speakers"][name] = scoreJson(s, o);
     for (std::size_t r = 0; r < set.size(); ++r)
         for (std::size_t h = 0; h < set.size(); ++h)
             if (report.total.schedule.confusion[r][h] > 0)
                 j["confusion"][set[r].name][set[h].name] = report.total.schedule.confusion[r][h];
     return j;
+}
+
+// The alignment's timing per speaker (dsp::scoreBoundaries).
+void printBoundaries(std::ostream& out, const Report& report) {
+    out << "\nboundaries: each labelled one against the aligned boundary nearest it between the "
+           "same two classes (none within 100 ms: missed, counted at 100 ms)\n"
+        << std::left << std::setw(30) << "speaker" << std::right << std::setw(11) << "boundaries"
+        << std::setw(10) << "median" << std::setw(14) << "within 20 ms" << std::setw(14)
+        << "within 50 ms" << std::setw(9) << "missed" << '\n';
+    const auto row = [&](const std::string& name, const dsp::BoundaryScore& b) {
+        const auto ms = [](double seconds) {
+            std::ostringstream s;
+            s << std::fixed << std::setprecision(1) << 1000 * seconds << " ms";
+            return s.str();
+        };
+        out << std::left << std::setw(30) << name << std::right << std::setw(11) << b.errors.size()
+            << std::setw(10) << ms(b.percentile(0.5)) << std::setw(14) << pct(b.shareWithin(0.02))
+            << std::setw(14) << pct(b.shareWithin(0.05)) << std::setw(9) << b.missed << '\n';
+    };
+    for (const auto& [name, s] : report.speakers) row(name, s.boundaries);
+    row("all", report.total.boundaries);
 }
 
 // The speaker with the lowest value of `figure`.
@@ -296,6 +331,7 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
     printHeader(out, "speaker", o.jaw);
     for (const auto& [name, s] : report.speakers) printRow(out, name, s, o.jaw);
     printRow(out, "all", report.total, o.jaw);
+    if (o.align) printBoundaries(out, report);
     const auto group = worst(report, [](const Score& s) { return s.schedule.groupAccuracy(); });
     out << "\nfiles " << report.files.size() << ", speakers " << report.speakers.size()
         << ", frames " << report.total.schedule.frames << ": accuracy "
@@ -432,7 +468,8 @@ void addEvalCommand(CLI::App& app) {
     cmd->add_flag("--align", o->align,
                   "Score 'lipsync align' instead: each NAME.wav aligned on the words of NAME.txt "
                   "beside it (files without one are skipped); the jaw 'audio' column is then "
-                  "the aligned schedule's");
+                  "the aligned schedule's, and each speaker's boundaries are timed against the "
+                  "labels' (median error, share within 20 and 50 ms, missed)");
     cmd->add_option("--voice", o->voices,
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");

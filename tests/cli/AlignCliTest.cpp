@@ -47,7 +47,13 @@ TEST(AlignCli, EvalAlignScoresTheAlignedWordsPerSpeakerAndVoice) {
         const auto& s = json["speakers"][speaker];
         EXPECT_GT(s["group_accuracy"].get<double>(), 0.7) << speaker;
         EXPECT_GT(s["jaw"]["audio"]["r"].get<double>(), 0.6) << speaker;
+        // espeak-ng's own timings: its boundaries come back within issue 11's 15 ms median.
+        const auto& b = s["boundaries"];
+        EXPECT_GT(b["count"].get<int>(), 10) << speaker;
+        EXPECT_LE(b["median_ms"].get<double>(), 15.0) << speaker;
+        EXPECT_LT(b["missed"].get<int>(), b["count"].get<int>() / 4) << speaker;
     }
+    EXPECT_NE(r.out.find("within 20 ms"), std::string::npos) << r.out;
     // Russian words read by the English voice are spelled, not said: far worse, or refused.
     const auto wrong = runLipsync(
         {"eval", "--corpus", (dir / "ivan").string(), "--align", "--json", "-", "--no-per-file"});

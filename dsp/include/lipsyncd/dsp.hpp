@@ -772,6 +772,24 @@ struct ScheduleScore {
 ScheduleScore scoreSchedule(const PhonemeSchedule& hypothesis, const PhonemeSchedule& reference,
                             const PhonemeSet& set, double step = 0.01);
 
+// How far a schedule's phoneme boundaries lie from the reference's: the forced aligner's timing,
+// which visual groups measure only where the classes on either side differ in group. Each
+// reference boundary (a change of phoneme) is matched with the nearest hypothesis boundary
+// between the same two phonemes; one without such a partner within `missedAfter` seconds is
+// missed and counts at that error.
+struct BoundaryScore {
+    std::vector<double> errors;  // seconds, one per reference boundary
+    std::size_t missed = 0;
+
+    void add(const BoundaryScore& other);
+    // The error at fraction p (0..1) of the sorted errors, in seconds (0 with no boundaries).
+    double percentile(double p) const;
+    // The share of boundaries placed within `seconds` (0..1; 0 with no boundaries).
+    double shareWithin(double seconds) const;
+};
+BoundaryScore scoreBoundaries(const PhonemeSchedule& hypothesis, const PhonemeSchedule& reference,
+                              double missedAfter = 0.1);
+
 AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet& templates,
                            const PhonemeSet& set, const FrontEndConfig& config = {},
                            const DecodeOptions& decode = {},
