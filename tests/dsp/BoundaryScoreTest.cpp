@@ -16,14 +16,17 @@ PhonemeSchedule schedule(std::initializer_list<std::pair<double, const char*>> s
     return s;
 }
 
+void expectErrors(const BoundaryScore& b, std::initializer_list<double> seconds) {
+    ASSERT_EQ(b.errors.size(), seconds.size());
+    std::size_t i = 0;
+    for (const double e : seconds) EXPECT_NEAR(b.errors[i++], e, 1e-9) << "boundary " << i;
+}
+
 TEST(BoundaryScore, ABoundaryPlacedLateCountsByHowLate) {
     const auto ref = schedule({{0, "sil"}, {0.2, "bmp"}, {0.3, "aa"}, {0.5, "sil"}}, 0.8);
     const auto hyp = schedule({{0, "sil"}, {0.215, "bmp"}, {0.3, "aa"}, {0.46, "sil"}}, 0.8);
     const auto b = scoreBoundaries(hyp, ref);
-    ASSERT_EQ(b.errors.size(), 3u);
-    EXPECT_NEAR(b.errors[0], 0.015, 1e-9);
-    EXPECT_NEAR(b.errors[1], 0.0, 1e-9);
-    EXPECT_NEAR(b.errors[2], 0.04, 1e-9);
+    expectErrors(b, {0.015, 0.0, 0.04});
     EXPECT_EQ(b.missed, 0u);
     EXPECT_NEAR(b.percentile(0.5), 0.015, 1e-9);
     EXPECT_NEAR(b.shareWithin(0.02), 2.0 / 3, 1e-9);
@@ -36,10 +39,7 @@ TEST(BoundaryScore, OnlyABoundaryBetweenTheSameTwoClassesWithinTheWindowCounts) 
     const auto hyp =
         schedule({{0, "sil"}, {0.21, "d"}, {0.3, "ah"}, {0.35, "ih"}, {0.65, "sil"}}, 0.8);
     const auto b = scoreBoundaries(hyp, ref);
-    ASSERT_EQ(b.errors.size(), 3u);
-    EXPECT_NEAR(b.errors[0], 0.01, 1e-9);
-    EXPECT_NEAR(b.errors[1], 0.1, 1e-9);
-    EXPECT_NEAR(b.errors[2], 0.1, 1e-9);
+    expectErrors(b, {0.01, 0.1, 0.1});
     EXPECT_EQ(b.missed, 2u);
     EXPECT_NEAR(scoreBoundaries(hyp, ref, 0.2).errors[2], 0.15, 1e-9);
 }
@@ -49,9 +49,7 @@ TEST(BoundaryScore, TheNearestOfTwoPartnersIsTaken) {
     const auto hyp =
         schedule({{0, "sil"}, {0.95, "aa"}, {0.97, "sil"}, {1.02, "aa"}, {1.2, "sil"}}, 2.0);
     const auto b = scoreBoundaries(hyp, ref);
-    ASSERT_EQ(b.errors.size(), 2u);
-    EXPECT_NEAR(b.errors[0], 0.02, 1e-9);
-    EXPECT_NEAR(b.errors[1], 0.0, 1e-9);
+    expectErrors(b, {0.02, 0.0});
 }
 
 TEST(BoundaryScore, RepeatedSegmentsOfOneClassAreNoBoundaryAndScoresAddUp) {
