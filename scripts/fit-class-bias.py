@@ -123,14 +123,22 @@ def fit(args):
 
 
 def write(path, bias):
-    """Replaces (or adds) the set's class_bias_db, leaving every other line as it is."""
+    """Replaces (or adds) the set's class_bias_db, leaving every other line as it is. A set
+    another tool wrote (not laid out as `lipsync` writes one) is written again whole, in
+    `lipsync`'s layout, rather than losing a fit that took minutes."""
     text = open(path).read()
-    json.loads(text)  # a broken set is not ours to rewrite
+    whole = json.loads(text)  # a broken set is not ours to rewrite
     block = ' "class_bias_db": ' + json.dumps(bias, indent=1).replace("\n", "\n ") + ",\n"
     text, n = re.subn(r' "class_bias_db": \{[^}]*\},\n', lambda _: block, text)
     if n == 0:
-        at = text.index('\n "class')  # before class_network / classes, as lipsync writes it
-        text = text[:at + 1] + block + text[at + 1:]
+        at = text.find('\n "class')  # before class_network / classes, as lipsync writes it
+        if at < 0:
+            whole["class_bias_db"] = bias
+            text = json.dumps(dict(sorted(whole.items())), indent=1) + "\n"
+            print(f"fit-class-bias: {path} is not laid out as lipsync writes a set: written "
+                  "again whole", file=sys.stderr)
+        else:
+            text = text[:at + 1] + block + text[at + 1:]
     json.loads(text)
     open(path, "w").write(text)
     print(f"fit-class-bias: wrote class_bias_db into {path}")

@@ -74,6 +74,17 @@ class FitClassBias(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertEqual(self.set.read_text().count("class_bias_db"), 1)
 
+    def test_a_set_laid_out_otherwise_still_gets_its_bias(self):
+        # Written on one line by another tool: the whole set is written again, nothing lost.
+        self.set.write_text(json.dumps({"classes": [], "analysis": {"bins": 32}}))
+        r = self.fit("--write")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("written again whole", r.stderr)
+        written = json.loads(self.set.read_text())
+        self.assertEqual(written["class_bias_db"], {"ah": -0.6, "w": 0.3})
+        self.assertEqual(written["analysis"], {"bins": 32})
+        self.assertEqual(written["classes"], [])
+
     def test_a_move_worth_less_than_the_minimum_gain_is_not_kept(self):
         # From ah −0.3 the step to −0.6 adds 2.7 points: kept at 1, not at 3.
         r = self.fit("--min-gain", "3", "--steps", "0.3")
