@@ -22,33 +22,30 @@ struct AlignerOptions {
             }
             return when + ": " + text;
         };
-        cmd.add_option("--min-word-confidence", config.minWordConfidence,
-                       help("words placed with less confidence get audio-only analysis; in a line "
-                            "whose median word confidence reaches it, a word needs only 0.4 of "
-                            "that median, and the word of a one-word line 0.1 (never more than "
-                            "this)"))
-            ->check(CLI::Range(0.0, 1.0))
-            ->capture_default_str();
-        cmd.add_option("--reduction-cost", config.reductionCost,
-                       help("cost of saying a word another way than espeak-ng reads it"))
-            ->check(CLI::Range(0.0, 100.0))
-            ->capture_default_str();
-        cmd.add_option("--silence-in-speech-cost", config.silenceInSpeechCost,
-                       help("cost per frame of silence where the energy gate hears speech"))
-            ->check(CLI::Range(0.0, 100.0))
-            ->capture_default_str();
-        cmd.add_option("--second-pass-prior", config.fileAdaptationPriorFrames,
-                       help("align a second time on templates moved toward the file's own voice "
-                            "(what the first pass placed); the templates weigh as this many "
-                            "frames (0: one pass)"))
-            ->check(CLI::Range(0.0, 1000.0))
-            ->capture_default_str();
-        cmd.add_option("--class-network-share", config.classNetworkShare,
-                       help("how much of the class network's term (and the class bias) the "
-                            "aligner weighs beside the templates' distances (0: the templates "
-                            "alone)"))
-            ->check(CLI::Range(0.0, 1.0))
-            ->capture_default_str();
+        // A cost, share or floor: a number from 0 to `max`, its default shown.
+        const auto number = [&](const std::string& name, float& field, const std::string& text,
+                                double max) {
+            cmd.add_option(name, field, help(text))
+                ->check(CLI::Range(0.0, max))
+                ->capture_default_str();
+        };
+        number("--min-word-confidence", config.minWordConfidence,
+               "words placed with less confidence get audio-only analysis; in a line whose median "
+               "word confidence reaches it, a word needs only 0.4 of that median, and the word of "
+               "a one-word line 0.1 (never more than this)",
+               1.0);
+        number("--reduction-cost", config.reductionCost,
+               "cost of saying a word another way than espeak-ng reads it", 100.0);
+        number("--silence-in-speech-cost", config.silenceInSpeechCost,
+               "cost per frame of silence where the energy gate hears speech", 100.0);
+        number("--second-pass-prior", config.fileAdaptationPriorFrames,
+               "align a second time on templates moved toward the file's own voice (what the "
+               "first pass placed); the templates weigh as this many frames (0: one pass)",
+               1000.0);
+        number("--class-network-share", config.classNetworkShare,
+               "how much of the class network's term (and the class bias) the aligner weighs "
+               "beside the templates' distances (0: the templates alone)",
+               1.0);
         cmd.add_flag("!--no-reductions", reductions,
                      help("follow espeak-ng's reading only, without the common reductions "
                           "(config/reductions/LANG.toml: weak forms, t/d and schwa deletion)"));
