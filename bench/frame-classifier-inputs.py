@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """What a frame classifier could hear from other inputs: the offline measurements behind the
-README's "Real people" tables on frame-classifier inputs (a development tool; needs python3-numpy).
+docs/measurements.md's "Real people" tables on frame-classifier inputs (a development tool; needs python3-numpy).
 
     bench/frame-classifier-inputs.py [--real build/real-speech] [--corpus build/corpus/train]
                                      [--lipsync build/cli/lipsync] [--cache build/frame-inputs]

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # How a change to the front end or its training is judged before it ships: on voices the
-# templates have never heard, never on the dev speakers (README, "Real people").
+# templates have never heard, never on the dev speakers (docs/measurements.md, "Real people").
 #
 #   scripts/held-out-check.sh [--work DIR] [--no-fetch] [--dev]
 #

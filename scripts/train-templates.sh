@@ -5,10 +5,10 @@
 # from Debian packages, labelled by forced alignment or their own phone labels). Reproducible:
 # the same espeak-ng, packages and build give the same file. (The shipped files were trained on
 # labeller 2's labels, before the asterisk prompts were labelled on their 16 kHz recordings: on
-# labeller 3's this recipe shuts the mouth more often by mistake, so they were kept. README, "Real
-# people": "Retrained on labeller 3's labels".) Neither the espeak-ng development
-# corpus (held-out sentences and voices) nor any real dev speaker is used here; they are for
-# `lipsync eval`.
+# labeller 3's this recipe shuts the mouth more often by mistake, so they were kept.
+# docs/measurements.md, "Real people": "Retrained on labeller 3's labels".) Neither the
+# espeak-ng development corpus (held-out sentences and voices) nor any real dev speaker is used
+# here; they are for `lipsync eval`.
 #
 #   scripts/train-templates.sh                  # templates, then the networks beside them
 #   scripts/train-templates.sh --networks-only  # keep the shipped templates, retrain the networks
@@ -104,7 +104,7 @@ done
 # asterisk-en-allison, audio only) the templates with them gave 76.7 / 46.5 % visual groups
 # against 76.3 / 45.0 %, closures caught 100 / 96.9 % against 100 / 96.1 %; networks trained on
 # them too 77.3 / 46.8 %, but closures caught 100 / 94.4 %. (Not listed in the shipped set's
-# training yet: README, "Real people".)
+# training yet: docs/measurements.md, "Real people".)
 template_folders=()
 if [ ${#by_aligner[@]} -gt 0 ]; then
   labeller="$real/labeller-templates.json"
@@ -136,7 +136,7 @@ if [ "$mode" = --channel-normalised ]; then
   # / asterisk-en-allison visual groups, audio only and aligned on the words: 76.3 / 45.0 and
   # 85.2 / 54.3 % with the default set's training, 77.0 / 45.5 and 88.4 / 54.3 % at 2 s, 76.4 /
   # 44.9 and 84.7 / 54.3 % at 5 s). Opt-in (--templates channel-normalised): the aligner's costs
-  # were tuned on unnormalised distances (README, "Real people").
+  # were tuned on unnormalised distances (docs/measurements.md, "Real people").
   shipped="$here/config/templates/channel-normalised.json"
   kind="Channel-normalised templates" detail="$detail, the running mean spectrum subtracted"
   channel=(--normalise-channel --mean-prior 2)
@@ -151,7 +151,7 @@ fi
 # 1,230 s against 7,600 s of people). The jaw network has 32 hidden units, the class network 64,
 # 4 passes each. Chosen on the six tune voices (summed, audio only, before any class bias) and
 # on the training speakers each left out of the networks (klettres-en-gb / asterisk-en-allison;
-# README, "More people in the networks"):
+# docs/measurements.md, "More people in the networks"):
 #   without the tuxpaint readers, 32 units, espeak-ng twice: tune 270.1 % visual groups, jaw r
 #     3.80; left out 78.9 / 60.3 %; espeak-ng dev 79.9 % (worst voice 72.7 %)
 #   with them, 32 units, twice: 279.3, 3.90; espeak-ng dev 78.3 % (worst 70.1 %)

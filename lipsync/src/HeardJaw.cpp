@@ -3,7 +3,7 @@
 // far as the pick says. The front end's per-frame jaw estimate (dsp FrameLabel::jaw) weighs
 // every class by its nearness instead, so classes of like height agree whichever wins; blended
 // into the jaw pose it keeps the runtime's timing and closures and takes the height from what
-// was heard. (Measured per speaker in README, "The heard jaw".)
+// was heard. (Measured per speaker in docs/measurements.md, "The heard jaw".)
 #include <algorithm>
 #include <cmath>
 #include <lipsyncd/lipsync.hpp>

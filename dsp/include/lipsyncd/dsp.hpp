@@ -876,7 +876,7 @@ struct AlignerConfig {
     // espeak-ng training corpus unchanged.
     float skipWordCost = 25.0f;
     // Saying a word another way than espeak-ng reads it (ScriptWord::alternatives): a reduction
-    // must fit clearly better to be taken. See bench/align_accuracy and README for the tuning.
+    // must fit clearly better to be taken. See bench/align_accuracy and docs/measurements.md for the tuning.
     float reductionCost = 4.0f;
     float beam = 60.0f;  // paths this much worse than the best are dropped
     int maxActiveNodes = 4000;
