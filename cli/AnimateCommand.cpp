@@ -27,6 +27,8 @@ void runAnimate(const AnimateOptions& o) {
         std::optional<LevelTrack> levels;
         if (!o.audio.empty()) {
             const auto audio = dsp::readAudioFile(o.audio);
+            for (const auto& w : audio.warnings)
+                std::cerr << "lipsync animate: warning: " << w << '\n';
             levels = dsp::measureLevels(audio.samples, audio.sampleRate);
         }
         o.runtime.writeWeights(o.runtime.animate(schedule, levels ? &*levels : nullptr));

@@ -158,6 +158,7 @@ struct Evaluator {
                     : std::nullopt;
         auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
                                   o.frontEnd.decode(), std::nullopt);
+        for (const auto& w : a.warnings) std::cerr << "lipsync eval: warning: " << w << '\n';
         if (speaker && wordsBeside(item.audio)) align(item, speaker);
         return {std::move(a.schedule), std::move(a.levels)};
     }

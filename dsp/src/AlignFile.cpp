@@ -324,6 +324,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
         total += static_cast<std::int64_t>(n);
     }
     analyzer.finish();
+    r.warnings = decoder.warnings();
     r.durationSeconds = static_cast<double>(total) / decoder.sampleRate();
     if (!r.audioOnly.empty()) r.audioOnly.back().end = r.durationSeconds;
     r.alignment = aligner.finish();

@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <lipsyncd/dsp.hpp>
+#include <optional>
+#include <string_view>
 
 namespace lipsyncd::dsp {
 
@@ -53,6 +56,48 @@ void shortsToFloats(const short* in, std::span<float> out) {
 struct SndfileCloser {
     void operator()(SNDFILE* f) const { sf_close(f); }
 };
+
+// Header sizes a recorder writes before it knows the length (a WAV streamed to a pipe): not a
+// promise of that much audio.
+constexpr long long kStreamedLength = 0x7FFF0000;
+
+// libsndfile reads a file whose header promises more audio than the file holds as far as it
+// goes, and says so only in its log, as "data : 230036 (should be 2956)" (the WAV data chunk;
+// AIFF's is SSND). The promised and held byte counts, when that is so.
+std::optional<std::pair<long long, long long>> cutShort(SNDFILE* f) {
+    std::string log(8192, '\0');
+    sf_command(f, SFC_GET_LOG_INFO, log.data(), static_cast<int>(log.size()));
+    for (std::size_t at = 0; at < log.size() && log[at];) {
+        const auto end = std::min(log.find('\n', at), log.size());
+        const auto line = std::string_view(log).substr(at, end - at);
+        at = end + 1;
+        const auto first = line.find_first_not_of(' ');
+        if (first == std::string_view::npos) continue;
+        const auto chunk = line.substr(first);
+        const auto should = chunk.find("(should be ");
+        if (!(chunk.starts_with("data") || chunk.starts_with("SSND")) ||
+            should == std::string_view::npos || chunk.find(':') == std::string_view::npos)
+            continue;
+        const long long promised = std::atoll(chunk.data() + chunk.find(':') + 1);
+        const long long held = std::atoll(chunk.data() + should + 11);
+        if (promised > held && held >= 0 && promised < kStreamedLength)
+            return std::pair(promised, held);
+    }
+    return std::nullopt;
+}
+
+std::string seconds(double s) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f s", s);
+    return text;
+}
+
+// AudioDecoder::warnings()'s word for a file cut short; `why`: the decoder's reason, if any.
+std::string truncated(const std::string& name, const std::string& promised, double held,
+                      const std::string& why = "") {
+    return name + ": truncated: its header promises " + promised + " of audio, the file holds " +
+           seconds(held) + (why.empty() ? "" : " (" + why + ")") + "; read as far as it goes";
+}
 }  // namespace
 
 RawFormat RawFormat::parse(const std::string& spec) {
@@ -86,6 +131,8 @@ struct AudioDecoder::State {
     std::vector<float> interleaved;
     std::vector<short> shorts;  // 16-bit PCM is read as shorts (shortsToFloats)
     std::int64_t nonFinite = 0;
+    std::int64_t framesRead = 0;
+    std::vector<std::string> warnings;
 };
 
 AudioDecoder::AudioDecoder(std::unique_ptr<State> state) : state_(std::move(state)) {}
@@ -131,6 +178,13 @@ AudioDecoder AudioDecoder::open(const std::filesystem::path& file, const DecodeO
     s->interleaved.resize(kBlockFrames * static_cast<std::size_t>(s->info.channels));
     if ((s->info.format & SF_FORMAT_SUBMASK) == SF_FORMAT_PCM_16)
         s->shorts.resize(s->interleaved.size());
+    if (const auto cut = raw || file == "-" ? std::nullopt : cutShort(f)) {
+        const double held = static_cast<double>(s->info.frames) / s->info.samplerate;
+        const double promised = cut->second > 0 ? held * cut->first / cut->second : 0;
+        s->warnings.push_back(truncated(
+            s->name, cut->second > 0 ? seconds(promised) : std::to_string(cut->first) + " bytes",
+            held));
+    }
     // libsndfile scales integer PCM to [-1, 1); floats are passed through as they are.
     sf_command(f, SFC_SET_NORM_FLOAT, nullptr, SF_TRUE);
     return AudioDecoder(std::move(s));
@@ -147,6 +201,25 @@ const std::string& AudioDecoder::name() const {
 }
 std::int64_t AudioDecoder::nonFiniteSamples() const {
     return state_->nonFinite;
+}
+const std::vector<std::string>& AudioDecoder::warnings() const {
+    return state_->warnings;
+}
+
+// A compressed file cut short (FLAC, Ogg) keeps its header's length, and its decoder stops where
+// the data does: the end came before the frames the header declares.
+void AudioDecoder::noteEarlyEnd() {
+    auto& s = *state_;
+    const auto declared = frames();
+    if (!declared || s.framesRead >= *declared || !s.warnings.empty()) return;
+    const double rate = s.info.samplerate;
+    // libsndfile's reason, as "Error : flac decoder lost sync.": the words alone.
+    std::string why = sf_strerror(s.file.get());
+    if (why.starts_with("Error : ")) why.erase(0, 8);
+    while (!why.empty() && why.back() == '.') why.pop_back();
+    if (why == "No Error") why.clear();
+    s.warnings.push_back(truncated(s.name, seconds(static_cast<double>(*declared) / rate),
+                                   static_cast<double>(s.framesRead) / rate, why));
 }
 
 std::optional<std::int64_t> AudioDecoder::frames() const {
@@ -165,6 +238,8 @@ std::size_t AudioDecoder::read(std::span<float> out) {
         pcm16 ? sf_readf_short(s.file.get(), s.shorts.data(), static_cast<sf_count_t>(want))
               : sf_readf_float(s.file.get(), s.interleaved.data(), static_cast<sf_count_t>(want));
     if (got < 0) throw InputError(s.name + ": read error (" + sf_strerror(s.file.get()) + ")");
+    s.framesRead += got;
+    if (got == 0 && want > 0) noteEarlyEnd();
     const auto n = static_cast<std::size_t>(got);
     if (pcm16 && channels == 1) {  // always finite and within [-1, 1)
         shortsToFloats(s.shorts.data(), out.first(n));
@@ -202,6 +277,7 @@ MonoAudio readAudioFile(const std::filesystem::path& file, const DecodeOptions& 
     std::vector<float> block(kBlockFrames);
     while (const auto n = decoder.read(block))
         audio.samples.insert(audio.samples.end(), block.begin(), block.begin() + n);
+    audio.warnings = decoder.warnings();
     return audio;
 }
 

@@ -98,6 +98,7 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
     analyzer.finish();
     result.durationSeconds = static_cast<double>(total) / decoder.sampleRate();
     result.nonFiniteSamples = decoder.nonFiniteSamples();
+    result.warnings = decoder.warnings();
     if (!result.schedule.empty()) result.schedule.back().end = result.durationSeconds;
     result.levels.rate = 1 / templates.analysis.hopSeconds;  // the templates' hop rules
     return result;

@@ -63,6 +63,7 @@ Preview renderRecordingPreview(EspeakSynthesizer& speech, const dsp::TemplateSet
     const UploadedAudio upload(bytes);
     const auto audio = decode(upload, maxSeconds);
     std::vector<std::string> warnings;
+    for (const auto& w : audio.warnings) warnings.push_back(upload.named(w));
     std::optional<dsp::AlignFileResult> aligned;
     if (!text) {
         warnings.push_back(
@@ -71,7 +72,9 @@ Preview renderRecordingPreview(EspeakSynthesizer& speech, const dsp::TemplateSet
     } else {
         try {
             aligned = alignText(speech, upload.path(), *text, voice, templates);
-            for (const auto& w : aligned->warnings) warnings.push_back(upload.named(w));
+            for (const auto& w : aligned->warnings)  // (the decoder's are there already)
+                if (std::find(warnings.begin(), warnings.end(), upload.named(w)) == warnings.end())
+                    warnings.push_back(upload.named(w));
         } catch (const InputError& e) {
             warnings.push_back("words not used: " + upload.named(e.what()) +
                                "; audio-only analysis");

@@ -78,6 +78,22 @@ TEST(LipsyncCli, NonAudioBytesNameTheFile) {
     EXPECT_NE(r.err.find(path.string()), std::string::npos) << r.err;
 }
 
+// A cut-short file is analysed as far as it goes, with a warning naming it: analyze and align.
+TEST(LipsyncCli, ATruncatedFileIsAnalysedWithAWarning) {
+    const auto cut = scratchDir("cli_truncated") / "cut.wav";
+    fs::copy_file(exampleWav(), cut, fs::copy_options::overwrite_existing);
+    fs::resize_file(cut, fs::file_size(cut) / 2);
+    const auto analyzed = runLipsync({"analyze", cut.string(), "-s", "-", "-q"});
+    EXPECT_EQ(analyzed.exitCode, 0) << analyzed.err;
+    EXPECT_FALSE(analyzed.out.empty());
+    EXPECT_NE(analyzed.err.find("warning: " + cut.string() + ": truncated"), std::string::npos)
+        << analyzed.err;
+    const auto aligned =
+        runLipsync({"align", cut.string(), "--text", "Hello puppet", "-s", "-", "-q"});
+    EXPECT_EQ(aligned.exitCode, 0) << aligned.err;
+    EXPECT_NE(aligned.err.find(cut.string() + ": truncated"), std::string::npos) << aligned.err;
+}
+
 TEST(LipsyncCli, AnalyzeWritesAScheduleThatReadsBack) {
     const auto out = scratchDir("cli_analyze") / "hello.tsv";
     const auto frames = out.parent_path() / "frames.csv";

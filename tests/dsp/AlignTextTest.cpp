@@ -379,6 +379,16 @@ TEST(AlignText, WordsBesideAPlayedFileAreUsedAndLogged) {
     ASSERT_FALSE(log.empty());
     EXPECT_NE(log.front().find("not used"), std::string::npos) << log.front();
     std::filesystem::remove(words);
+
+    // A file cut short is played as far as it goes, and the log says so, aligned or not.
+    std::filesystem::resize_file(file, std::filesystem::file_size(file) / 2);
+    for (const auto& text : {std::optional<std::string>(), std::optional<std::string>(kLine)}) {
+        log.clear();
+        EXPECT_FALSE(scheduleForClip(synth(), file, text, "en-us", templates, {}, logger).empty());
+        EXPECT_TRUE(std::any_of(log.begin(), log.end(), [&](const std::string& line) {
+            return line.find(file.string() + ": truncated") != std::string::npos;
+        })) << (text ? "aligned" : "audio only");
+    }
 }
 
 // The service's show voice (lipsyncd's adapt_speaker): lines played with their words teach the

@@ -218,14 +218,31 @@ TEST(FrontEnd, ZeroLengthAudioGivesAnEmptySchedule) {
     EXPECT_LE(result.schedule.size(), 1u);
 }
 
-TEST(FrontEnd, TruncatedDataIsReadAsFarAsItGoes) {
+// A file cut short (a copy or a download interrupted) is read as far as it goes, and the user
+// is told: its header promised more. WAV and AIFF headers say how much audio follows (libsndfile
+// then reads less and says so in its log); a FLAC decoder loses sync where the data stops.
+TEST(FrontEnd, TruncatedDataIsReadAsFarAsItGoesAndSaidToBe) {
     const auto& speech = test::testSpeech();
-    const auto file =
-        test::writeAudio("cut.wav", speech.samples, speech.rate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
-    std::filesystem::resize_file(file, std::filesystem::file_size(file) / 2);
-    const auto result = analyze(file);
-    EXPECT_NEAR(result.durationSeconds, speech.samples.size() / 2.0 / speech.rate, 0.01);
-    EXPECT_FALSE(result.schedule.empty());
+    const double seconds = static_cast<double>(speech.samples.size()) / speech.rate;
+    for (const auto& [name, format] : {std::pair("cut.wav", SF_FORMAT_WAV | SF_FORMAT_PCM_16),
+                                       std::pair("cut.aiff", SF_FORMAT_AIFF | SF_FORMAT_PCM_16),
+                                       std::pair("cut.flac", SF_FORMAT_FLAC | SF_FORMAT_PCM_16)}) {
+        SCOPED_TRACE(name);
+        const auto file = test::writeAudio(name, speech.samples, speech.rate, format);
+        const auto whole = analyze(file);
+        EXPECT_TRUE(whole.warnings.empty()) << whole.warnings.front();
+        std::filesystem::resize_file(file, std::filesystem::file_size(file) / 2);
+        const auto result = analyze(file);
+        EXPECT_LT(result.durationSeconds, 0.7 * seconds);
+        EXPECT_GT(result.durationSeconds, 0.2 * seconds);
+        EXPECT_FALSE(result.schedule.empty());
+        ASSERT_EQ(result.warnings.size(), 1u);
+        const auto& warning = result.warnings.front();
+        EXPECT_NE(warning.find(file.string() + ": truncated"), std::string::npos) << warning;
+        char promised[32];
+        std::snprintf(promised, sizeof promised, "promises %.2f s", seconds);
+        EXPECT_NE(warning.find(promised), std::string::npos) << warning;
+    }
 }
 
 TEST(FrontEnd, NaNSamplesAreCountedAndReadAsSilence) {

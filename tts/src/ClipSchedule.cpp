@@ -15,6 +15,13 @@ std::optional<std::filesystem::path> wordsBeside(const std::filesystem::path& au
 }
 
 namespace {
+// A warning as the log shows it: with the file's name in front, once (the decoder's and the
+// aligner's file-wide ones have it already).
+std::string namingTheFile(const std::filesystem::path& audio, const std::string& warning) {
+    const auto name = audio.string() + ": ";
+    return warning.starts_with(name) ? warning : name + warning;
+}
+
 std::optional<std::string> readWords(const std::filesystem::path& file,
                                      const std::function<void(const std::string&)>& log) {
     std::ifstream in(file);
@@ -46,7 +53,7 @@ PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem:
                                      std::nullopt, true, speaker);
             log(audio.string() + ": words from " + source + " aligned" +
                 (r.fellBack ? " (fell back to audio-only analysis)" : ""));
-            for (const auto& w : r.warnings) log(audio.string() + ": " + w);
+            for (const auto& w : r.warnings) log(namingTheFile(audio, w));
             if (levels) *levels = r.levels;
             return r.schedule;
         } catch (const InputError& e) {
@@ -59,6 +66,7 @@ PhonemeSchedule scheduleForClip(EspeakSynthesizer& synth, const std::filesystem:
         speaker ? speaker->adaptedIfHeard(dsp::AlignerConfig{}.speakerAdaptationPriorFrames)
                 : std::nullopt;
     auto r = dsp::analyzeFile(audio, own ? *own : templates, PhonemeSet::common(), {}, decode);
+    for (const auto& w : r.warnings) log(w);
     if (levels) *levels = std::move(r.levels);
     return std::move(r.schedule);
 }

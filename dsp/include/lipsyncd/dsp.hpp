@@ -71,10 +71,15 @@ class AudioDecoder {
     std::size_t read(std::span<float> out);
     std::int64_t nonFiniteSamples() const;
     const std::string& name() const;
+    // What was wrong with the file that could be read past, each naming the file, for the user
+    // (empty: nothing): a header that promises more audio than the file holds (a copy or a
+    // download cut short), which is read as far as it goes. Complete once read() has returned 0.
+    const std::vector<std::string>& warnings() const;
 
   private:
     struct State;
     explicit AudioDecoder(std::unique_ptr<State> state);
+    void noteEarlyEnd();
     std::unique_ptr<State> state_;
 };
 
@@ -82,6 +87,7 @@ class AudioDecoder {
 struct MonoAudio {
     std::vector<float> samples;
     int sampleRate = 0;
+    std::vector<std::string> warnings;  // AudioDecoder::warnings()
 };
 MonoAudio readAudioFile(const std::filesystem::path& file, const DecodeOptions& options = {});
 // Writes 16-bit PCM WAV.
@@ -655,6 +661,7 @@ struct AnalysisResult {
     int inputRate = 0;
     double resamplerDelaySeconds = 0;
     std::int64_t nonFiniteSamples = 0;
+    std::vector<std::string> warnings;  // the decoder's (AudioDecoder::warnings())
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -876,7 +883,8 @@ struct AlignerConfig {
     // espeak-ng training corpus unchanged.
     float skipWordCost = 25.0f;
     // Saying a word another way than espeak-ng reads it (ScriptWord::alternatives): a reduction
-    // must fit clearly better to be taken. See bench/align_accuracy and docs/measurements.md for the tuning.
+    // must fit clearly better to be taken. See bench/align_accuracy and docs/measurements.md for
+    // the tuning.
     float reductionCost = 4.0f;
     float beam = 60.0f;  // paths this much worse than the best are dropped
     int maxActiveNodes = 4000;
