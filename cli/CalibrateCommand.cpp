@@ -191,7 +191,10 @@ void runCalibrate(const CalibrateOptions& o) {
                 << "' is not a phoneme class (name files after a class: aa.wav, bmp.wav...)\n";
             continue;
         }
-        trainer.addSustained(dsp::analyzeFrames(entry.path(), training.analysis), cls);
+        std::vector<std::string> warnings;
+        trainer.addSustained(dsp::analyzeFrames(entry.path(), training.analysis, {}, &warnings),
+                             cls);
+        for (const auto& w : warnings) std::cerr << "lipsync calibrate: warning: " << w << '\n';
         addOnce(recorded, cls);
     }
     if (recorded.empty())

@@ -69,7 +69,9 @@ void runTrain(TrainOptions o) {
         for (const auto& s : skipped) std::cerr << "lipsync train: skipped " << s << '\n';
         for (const auto& item : items) {
             const auto labels = readLabels(item.labels, o.labels);
-            const auto frames = dsp::analyzeFrames(item.audio, o.training.analysis);
+            std::vector<std::string> warnings;
+            const auto frames = dsp::analyzeFrames(item.audio, o.training.analysis, {}, &warnings);
+            for (const auto& w : warnings) std::cerr << "lipsync train: warning: " << w << '\n';
             trainer.addUtterance(frames, labels);
             seconds += frames.size() * o.training.analysis.hopSeconds;
             if (++files % 50 == 0)

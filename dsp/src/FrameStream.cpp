@@ -82,8 +82,8 @@ void FrameStream::finish(const Sink& sink) {
 }
 
 std::vector<FrameFeatures> analyzeFrames(const std::filesystem::path& file,
-                                         const AnalysisConfig& config,
-                                         const DecodeOptions& decode) {
+                                         const AnalysisConfig& config, const DecodeOptions& decode,
+                                         std::vector<std::string>* warnings) {
     auto decoder = AudioDecoder::open(file, decode);
     FrameStream stream(config, decoder.sampleRate(), ResamplerQuality::Medium,
                        ResamplerUse::WholeFile);
@@ -93,6 +93,7 @@ std::vector<FrameFeatures> analyzeFrames(const std::filesystem::path& file,
     while (const auto n = decoder.read(block))
         stream.push(std::span<const float>(block.data(), n), keep);
     stream.finish(keep);
+    if (warnings) *warnings = decoder.warnings();
     return frames;
 }
 

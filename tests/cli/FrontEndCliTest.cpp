@@ -78,9 +78,11 @@ TEST(LipsyncCli, NonAudioBytesNameTheFile) {
     EXPECT_NE(r.err.find(path.string()), std::string::npos) << r.err;
 }
 
-// A cut-short file is analysed as far as it goes, with a warning naming it: analyze and align.
+// A cut-short file is analysed as far as it goes, with a warning naming it: analyze, align and
+// train.
 TEST(LipsyncCli, ATruncatedFileIsAnalysedWithAWarning) {
-    const auto cut = scratchDir("cli_truncated") / "cut.wav";
+    const auto dir = scratchDir("cli_truncated");
+    const auto cut = dir / "cut.wav";
     fs::copy_file(exampleWav(), cut, fs::copy_options::overwrite_existing);
     fs::resize_file(cut, fs::file_size(cut) / 2);
     const auto analyzed = runLipsync({"analyze", cut.string(), "-s", "-", "-q"});
@@ -92,6 +94,18 @@ TEST(LipsyncCli, ATruncatedFileIsAnalysedWithAWarning) {
         runLipsync({"align", cut.string(), "--text", "Hello puppet", "-s", "-", "-q"});
     EXPECT_EQ(aligned.exitCode, 0) << aligned.err;
     EXPECT_NE(aligned.err.find(cut.string() + ": truncated"), std::string::npos) << aligned.err;
+    const auto labels = fs::path(exampleWav()).replace_extension(".lab");
+    fs::copy_file(labels, dir / "cut.lab", fs::copy_options::overwrite_existing);
+    for (const std::string whole : {"whole1", "whole2", "whole3", "whole4"}) {  // enough frames
+        fs::copy_file(exampleWav(), dir / (whole + ".wav"), fs::copy_options::overwrite_existing);
+        fs::copy_file(labels, dir / (whole + ".lab"), fs::copy_options::overwrite_existing);
+    }
+    const auto trained = runLipsync({"train", dir.string(), "--clusters", "1", "--jaw-hidden", "0",
+                                     "--class-hidden", "0", "-o", (dir / "set.json").string()});
+    EXPECT_EQ(trained.exitCode, 0) << trained.err;
+    EXPECT_NE(trained.err.find("warning: " + cut.string() + ": truncated"), std::string::npos)
+        << trained.err;
+    EXPECT_EQ(trained.err.find("whole1.wav: truncated"), std::string::npos) << trained.err;
 }
 
 TEST(LipsyncCli, AnalyzeWritesAScheduleThatReadsBack) {

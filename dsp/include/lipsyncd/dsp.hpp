@@ -603,10 +603,12 @@ class FrameStream {
     double endTime_ = 0;
 };
 
-// Features of every frame of a file (training, calibration).
+// Features of every frame of a file (training, calibration); `warnings`, when given, gets the
+// decoder's (AudioDecoder::warnings()).
 std::vector<FrameFeatures> analyzeFrames(const std::filesystem::path& file,
                                          const AnalysisConfig& config,
-                                         const DecodeOptions& decode = {});
+                                         const DecodeOptions& decode = {},
+                                         std::vector<std::string>* warnings = nullptr);
 
 class StreamingAnalyzer {
   public:
