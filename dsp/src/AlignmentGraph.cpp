@@ -20,6 +20,10 @@ class GraphBuilder {
 
     AlignmentGraph build(std::span<const ScriptWord> script) {
         graph_.words = static_cast<int>(script.size());
+        // A one-word line's word is never skipped: its confidence alone says whether it was
+        // said (AlignerConfig::minSingleWordConfidence). Skipped, the whole line was filler and
+        // its word got no confidence at all; ktuberling's children lost four words that way.
+        maxSkipped_ = script.size() == 1 ? 0 : kMaxSkippedInARow;
         add({AlignmentNode::Kind::Start});
         units_.push_back({0});
         addGap(0);
@@ -43,7 +47,7 @@ class GraphBuilder {
 
     // Edges into `to` from the end of the unit before it, and, skipping words, from earlier.
     void fromPreviousUnits(int to, std::size_t unit, float cost) {
-        for (int skipped = 0; skipped <= kMaxSkippedInARow && skipped < static_cast<int>(unit);
+        for (int skipped = 0; skipped <= maxSkipped_ && skipped < static_cast<int>(unit);
              ++skipped)
             for (int from : units_[unit - 1 - skipped])
                 edge(from, to, cost + config_.skipWordCost * static_cast<float>(skipped),
@@ -71,7 +75,7 @@ class GraphBuilder {
         for (int node : {first, f}) {
             const float enter = node == first && inner ? config_.pauseCost : 0.0f;
             for (int from : units_[unit]) edge(from, node, enter);
-            for (int s = 1; s <= kMaxSkippedInARow && s <= static_cast<int>(unit); ++s)
+            for (int s = 1; s <= maxSkipped_ && s <= static_cast<int>(unit); ++s)
                 for (int from : units_[unit - s])  // the words between skipped
                     edge(from, node, enter + config_.skipWordCost * static_cast<float>(s), true);
         }
@@ -205,7 +209,7 @@ class GraphBuilder {
         }
         // Ending: after the last word, or with the last words skipped.
         const std::size_t last = units_.size() - 1;
-        for (int s = 0; s <= kMaxSkippedInARow && s < static_cast<int>(last) + 1; ++s)
+        for (int s = 0; s <= maxSkipped_ && s < static_cast<int>(last) + 1; ++s)
             for (int node : units_[last - s])
                 if (graph_.nodes[node].kind != AlignmentNode::Kind::Start)
                     graph_.endCost[node] = std::min(graph_.endCost[node],
@@ -233,6 +237,7 @@ class GraphBuilder {
     const PhonemeSet& set_;
     double hop_, scale_;
     AlignerConfig config_;
+    int maxSkipped_ = kMaxSkippedInARow;  // words skipped in a row, at most
     AlignmentGraph graph_;
     std::vector<std::vector<AlignmentEdge>> incoming_;
     // Per unit (the start, then each word) the nodes a path leaves it from: the word's last

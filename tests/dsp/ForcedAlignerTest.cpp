@@ -208,6 +208,25 @@ TEST(ForcedAligner, AWordTheSpeakerSkippedIsNotPlaced) {
     expectBoundariesAt(a.schedule, f.boundaries);
 }
 
+// A one-word line's word is never skipped, however poorly the voice fits it: it is aligned, and
+// its confidence says whether it was said. (Skipped, the line was all filler and its word had no
+// confidence at all: a child's "spectacles" in ktuberling.) In a longer line a word still may be.
+TEST(ForcedAligner, AOneWordLinesWordIsAlignedAndJudgedNotSkipped) {
+    Frames f;
+    f.add({{"sil", 20}});
+    f.add({{"kg", 22}});
+    f.add({{"sil", 20}});
+    for (auto& frame : f.distances)  // 10 dB further from every class than from /kg/
+        for (auto& d : frame) d = d > 4.0f ? 14.0f : d;
+    const std::vector<ScriptWord> script = {word("see", kSee)};
+    const auto a = f.align(script);
+    ASSERT_TRUE(a.complete);
+    ASSERT_EQ(a.words.size(), 1u);
+    EXPECT_GT(a.words[0].end - a.words[0].start, 0.1);
+    EXPECT_GT(a.words[0].confidence, 0.0f);
+    EXPECT_EQ(a.words[0].placed, a.words[0].confidence >= AlignerConfig{}.minSingleWordConfidence);
+}
+
 TEST(ForcedAligner, SoundsNobodyScriptedAreReportedAndTheWordsStillPlaced) {
     Frames f;
     f.add({{"sil", 20}});

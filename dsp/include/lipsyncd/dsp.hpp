@@ -877,7 +877,8 @@ struct AlignerConfig {
     float pauseCost = 3.0f;         // entering an optional pause between words
     double minPauseSeconds = 0.08;  // shortest pause between words
     float silenceLoopCost = 0.05f;  // per frame of it
-    // A word the speaker left out (at most two in a row). 15 skipped words a real voice said
+    // A word the speaker left out (at most two in a row; never the word of a one-word line, whose
+    // confidence alone decides: minSingleWordConfidence). 15 skipped words a real voice said
     // but the templates fit poorly (festvox-ru: "спокойным" in "Со спокойным мужеством", its
     // frames given to the words around it); on asterisk-en-allison, left out of its templates,
     // 15 / 25 / 40 gave 56.6 / 57.1 / 57.1 % aligned on the right text and 40.3 / 40.5 % on
