@@ -39,40 +39,35 @@ struct FrontEndOptions {
                        "16 kHz); high, veryhigh: libsoxr's steeper filters")
             ->check(CLI::IsMember({"low", "medium", "high", "veryhigh"}))
             ->capture_default_str();
+        // A number within [lo, hi], its default shown.
+        const auto number = [&](const std::string& name, auto& field, const std::string& text,
+                                double lo, double hi) {
+            cmd.add_option(name, field, text)->check(CLI::Range(lo, hi))->capture_default_str();
+        };
         // Shorter runs are flicker and merge into their neighbour; longer holds mean fewer,
         // steadier segments and a longer streaming delay (the longest minimum plus a hop).
-        cmd.add_option("--min-vowel", segmenter.minVowelSeconds, "Shortest vowel segment, seconds")
-            ->check(CLI::Range(0.0, 0.5))
-            ->capture_default_str();
-        cmd.add_option("--min-consonant", segmenter.minConsonantSeconds,
-                       "Shortest consonant segment, seconds")
-            ->check(CLI::Range(0.0, 0.5))
-            ->capture_default_str();
-        cmd.add_option("--min-silence", segmenter.minSilenceSeconds, "Shortest silence, seconds")
-            ->check(CLI::Range(0.0, 0.5))
-            ->capture_default_str();
-        cmd.add_option("--silence-below-peak", classifier.silenceBelowPeakDb,
-                       "Frames this many dB below the recent speech peak are silence, whatever "
-                       "the noise floor (0: off)")
-            ->check(CLI::Range(0.0, 80.0))
-            ->capture_default_str();
-        cmd.add_option("--jaw-spread", classifier.jawSpreadDb,
-                       "How far (dB of spectral distance) a class may lie from the nearest and "
-                       "still count towards the jaw height heard in a frame")
-            ->check(CLI::Range(0.01, 20.0))
-            ->capture_default_str();
-        cmd.add_option("--class-network-db", classifier.classNetworkDb,
-                       "With a template set that has a class network: dB of distance added per "
-                       "nat a class's likelihood lies below the likeliest class's (0: the "
-                       "templates alone)")
-            ->check(CLI::Range(0.0, 20.0))
-            ->capture_default_str();
-        cmd.add_option("--class-prior-scale", classifier.classPriorScale,
-                       "With a class network: how much of each class's share of the training "
-                       "frames its posterior is divided by (1: all, the hybrid's scaled "
-                       "likelihood; 0: none, common classes favoured)")
-            ->check(CLI::Range(0.0, 1.0))
-            ->capture_default_str();
+        number("--min-vowel", segmenter.minVowelSeconds, "Shortest vowel segment, seconds", 0.0,
+               0.5);
+        number("--min-consonant", segmenter.minConsonantSeconds,
+               "Shortest consonant segment, seconds", 0.0, 0.5);
+        number("--min-silence", segmenter.minSilenceSeconds, "Shortest silence, seconds", 0.0, 0.5);
+        number("--silence-below-peak", classifier.silenceBelowPeakDb,
+               "Frames this many dB below the recent speech peak are silence, whatever the noise "
+               "floor (0: off)",
+               0.0, 80.0);
+        number("--jaw-spread", classifier.jawSpreadDb,
+               "How far (dB of spectral distance) a class may lie from the nearest and still "
+               "count towards the jaw height heard in a frame",
+               0.01, 20.0);
+        number("--class-network-db", classifier.classNetworkDb,
+               "With a template set that has a class network: dB of distance added per nat a "
+               "class's likelihood lies below the likeliest class's (0: the templates alone)",
+               0.0, 20.0);
+        number("--class-prior-scale", classifier.classPriorScale,
+               "With a class network: how much of each class's share of the training frames its "
+               "posterior is divided by (1: all, the hybrid's scaled likelihood; 0: none, common "
+               "classes favoured)",
+               0.0, 1.0);
         cmd.add_option("--class-bias", classBias,
                        "dB added to a class's distance, CLASS=DB (repeatable; over the template "
                        "set's class_bias_db, a negative value favours the class)");
