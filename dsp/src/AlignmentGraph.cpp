@@ -47,8 +47,7 @@ class GraphBuilder {
 
     // Edges into `to` from the end of the unit before it, and, skipping words, from earlier.
     void fromPreviousUnits(int to, std::size_t unit, float cost) {
-        for (int skipped = 0; skipped <= maxSkipped_ && skipped < static_cast<int>(unit);
-             ++skipped)
+        for (int skipped = 0; skipped <= maxSkipped_ && skipped < static_cast<int>(unit); ++skipped)
             for (int from : units_[unit - 1 - skipped])
                 edge(from, to, cost + config_.skipWordCost * static_cast<float>(skipped),
                      skipped > 0);
