@@ -1,5 +1,6 @@
 // lipsync eval: how well `analyze` agrees with reference labels over a corpus, and how well a
 // puppet's jaw follows the speech, per file and per speaker (the worst speaker is the figure).
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <lipsyncd/dsp.hpp>
@@ -25,6 +26,7 @@ struct EvalOptions {
     std::string corpus;
     std::string labels = "auto";
     std::string json;
+    std::string schedules;  // --schedules DIR: each file's schedule as scored, DIR/SPEAKER/NAME.tsv
     std::string puppet = "jaw-servo", jawActuator;
     double minAccuracy = 0, minGroupAccuracy = 0;
     double minJawR = -1, minExactJawR = -1, minExactClosures = 0;
@@ -163,9 +165,21 @@ struct Evaluator {
         return {std::move(a.schedule), std::move(a.levels)};
     }
 
+    // --schedules: the schedule scored, where `lipsync analyze -s` (or align) would write it.
+    void keepSchedule(const CorpusItem& item, const PhonemeSchedule& hypothesis) const {
+        const auto dir = std::filesystem::path(o.schedules) / item.speaker;
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        const auto file = dir / (item.name + ".tsv");
+        std::ofstream out(file);
+        if (!out) throw InputError("--schedules: cannot write " + file.string());
+        writeSchedule(out, hypothesis);
+    }
+
     Score scoreFile(const CorpusItem& item) const {
         const auto reference = readLabels(item.labels, o.labels);
         const auto [hypothesis, levels] = schedule(item);
+        if (!o.schedules.empty()) keepSchedule(item, hypothesis);
         Score s;
         s.schedule = dsp::scoreSchedule(hypothesis, reference, set);
         if (o.align) s.boundaries = dsp::scoreBoundaries(hypothesis, reference);
@@ -436,6 +450,9 @@ void addEvalCommand(CLI::App& app) {
                     "Label alphabet: auto, common, arpabet, or a map name/file")
         ->capture_default_str();
     cmd->add_option("--json", o->json, "Also write the figures as JSON ('-' for stdout)");
+    cmd->add_option("--schedules", o->schedules,
+                    "Also write each file's schedule, as scored (aligned with --align), to "
+                    "DIR/SPEAKER/NAME.tsv: what to look at where a file scores badly");
     cmd->add_option("--puppet", o->puppet, "Puppet whose jaw is scored (name or file)")
         ->capture_default_str();
     cmd->add_option("--jaw-actuator", o->jawActuator,

@@ -193,6 +193,43 @@ TEST(LipsyncCli, AnalyzeReadsRawPcmFromStdin) {
     EXPECT_EQ(viaPipe.out, viaFile.out);
 }
 
+// --schedules keeps what was scored, file by file: the audio-only schedule is analyze's, the
+// aligned one align's.
+TEST(LipsyncCli, EvalWritesEachFilesScheduleAsScored) {
+    const auto corpus = scratchDir("cli_eval_schedules");
+    const auto speaker = corpus / "puppeteer";
+    fs::create_directories(speaker);
+    fs::copy_file(exampleWav(), speaker / "hello.wav", fs::copy_options::overwrite_existing);
+    fs::copy_file(fs::path(exampleWav()).replace_extension(".lab"), speaker / "hello.lab",
+                  fs::copy_options::overwrite_existing);
+    std::ofstream(speaker / "hello.txt") << "Hello puppet, open wide.\n";
+    const auto out = corpus / "out";
+    const auto written = (out / "puppeteer" / "hello.tsv").string();
+    const auto read = [](const std::string& file) {
+        std::ifstream in(file);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const auto audioOnly =
+        runLipsync({"eval", "--corpus", corpus.string(), "--schedules", out.string()});
+    ASSERT_EQ(audioOnly.exitCode, 0) << audioOnly.err;
+    const auto analyzed =
+        runLipsync({"analyze", (speaker / "hello.wav").string(), "-s", "-", "-q"});
+    EXPECT_EQ(read(written), analyzed.out);
+    const auto aligned =
+        runLipsync({"eval", "--corpus", corpus.string(), "--align", "--schedules", out.string()});
+    ASSERT_EQ(aligned.exitCode, 0) << aligned.err;
+    const auto byAlign = runLipsync({"align", (speaker / "hello.wav").string(), "--text-file",
+                                     (speaker / "hello.txt").string(), "-s", "-", "-q"});
+    EXPECT_EQ(read(written), byAlign.out);
+    EXPECT_NE(read(written), analyzed.out);
+    const auto blocked = corpus / "blocked";
+    std::ofstream(blocked) << "a file where a folder should be\n";
+    const auto refused =
+        runLipsync({"eval", "--corpus", corpus.string(), "--schedules", blocked.string()});
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_NE(refused.err.find(blocked.string()), std::string::npos) << refused.err;
+}
+
 TEST(LipsyncCli, EvalFailsBelowTheFloorAndPassesAboveIt) {
     const auto dir = exampleWav().parent_path();
     EXPECT_EQ(runLipsync({"eval", "--corpus", dir.string(), "--min-accuracy", "0.05"}).exitCode, 0);
