@@ -206,8 +206,9 @@ const std::vector<std::string>& AudioDecoder::warnings() const {
     return state_->warnings;
 }
 
-// A compressed file cut short (FLAC, Ogg) keeps its header's length, and its decoder stops where
-// the data does: the end came before the frames the header declares.
+// A FLAC file cut short keeps its header's length, and its decoder stops where the data does:
+// the end came before the frames the header declares. (An Ogg file states no length: its
+// length is where its last page ends, and a cut one cannot be told from a short one.)
 void AudioDecoder::noteEarlyEnd() {
     auto& s = *state_;
     const auto declared = frames();
