@@ -76,7 +76,7 @@ void runAlign(const AlignOptions& o) {
                              o.aligner.config, o.frontEnd.decode(), o.frontEnd.raw(),
                              o.aligner.reductions, speaker ? &*speaker : nullptr);
     if (speaker) speaker->save(o.speaker);
-    for (const auto& w : r.warnings) std::cerr << "lipsync align: warning: " << w << '\n';
+    printWarnings("align", r.warnings);
     if (!o.quiet) {
         const auto placed = std::count_if(r.alignment.words.begin(), r.alignment.words.end(),
                                           [](const dsp::AlignedWord& w) { return w.placed; });

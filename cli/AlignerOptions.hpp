@@ -7,6 +7,8 @@
 #include <lipsyncd/dsp.hpp>
 #include <string>
 
+#include "NumberOption.hpp"
+
 namespace lipsyncd::cli {
 
 struct AlignerOptions {
@@ -25,9 +27,7 @@ struct AlignerOptions {
         // A cost, share or floor: a number from 0 to `max`, its default shown.
         const auto number = [&](const std::string& name, float& field, const std::string& text,
                                 double max) {
-            cmd.add_option(name, field, help(text))
-                ->check(CLI::Range(0.0, max))
-                ->capture_default_str();
+            addNumberOption(cmd, name, field, help(text), 0.0, max);
         };
         number("--min-word-confidence", config.minWordConfidence,
                "words placed with less confidence get audio-only analysis; in a line whose median "

@@ -68,7 +68,7 @@ void runAnalyze(const AnalyzeOptions& o) {
     const auto result =
         dsp::analyzeFile(o.input, templates, set, o.frontEnd.config(), o.frontEnd.decode(),
                          o.frontEnd.raw(), !o.frames.empty() || !o.features.empty());
-    for (const auto& w : result.warnings) std::cerr << "lipsync analyze: warning: " << w << '\n';
+    printWarnings("analyze", result.warnings);
     if (result.nonFiniteSamples > 0)
         std::cerr << "lipsync analyze: warning: " << o.input << ": " << result.nonFiniteSamples
                   << " non-finite samples (NaN/inf) read as silence\n";

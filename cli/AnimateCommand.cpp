@@ -6,6 +6,7 @@
 
 #include "Commands.hpp"
 #include "Corpus.hpp"
+#include "Output.hpp"
 #include "RuntimeOptions.hpp"
 
 namespace lipsyncd::cli {
@@ -27,8 +28,7 @@ void runAnimate(const AnimateOptions& o) {
         std::optional<LevelTrack> levels;
         if (!o.audio.empty()) {
             const auto audio = dsp::readAudioFile(o.audio);
-            for (const auto& w : audio.warnings)
-                std::cerr << "lipsync animate: warning: " << w << '\n';
+            printWarnings("animate", audio.warnings);
             levels = dsp::measureLevels(audio.samples, audio.sampleRate);
         }
         o.runtime.writeWeights(o.runtime.animate(schedule, levels ? &*levels : nullptr));

@@ -12,6 +12,8 @@
 
 #include "Commands.hpp"
 #include "Corpus.hpp"
+#include "NumberOption.hpp"
+#include "Output.hpp"
 
 namespace lipsyncd::cli {
 
@@ -194,7 +196,7 @@ void runCalibrate(const CalibrateOptions& o) {
         std::vector<std::string> warnings;
         trainer.addSustained(dsp::analyzeFrames(entry.path(), training.analysis, {}, &warnings),
                              cls);
-        for (const auto& w : warnings) std::cerr << "lipsync calibrate: warning: " << w << '\n';
+        printWarnings("calibrate", warnings);
         addOnce(recorded, cls);
     }
     if (recorded.empty())
@@ -240,9 +242,7 @@ void addCalibrateCommand(CLI::App& app) {
                     "Vocal-tract-length warp of the spectrum: 'auto' chooses it on the read "
                     "speech (0.85..1.15; none without words), or a value 0.7..1.4 (1: none)")
         ->capture_default_str();
-    cmd->add_option("--clusters", o->clusters, "Cluster means per recorded class")
-        ->check(CLI::Range(1, 8))
-        ->capture_default_str();
+    addNumberOption(*cmd, "--clusters", o->clusters, "Cluster means per recorded class", 1, 8);
     cmd->callback([o] { runCalibrate(*o); });
 }
 

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "Commands.hpp"
+#include "NumberOption.hpp"
 
 namespace lipsyncd::cli {
 
@@ -109,9 +110,7 @@ void addEditCommand(CLI::App& app) {
                     "lipsyncd's control socket: the preview moves the puppet it drives too");
     cmd->add_option("--puppet", o->puppet,
                     "With --socket: the puppet lipsyncd must be driving (refused otherwise)");
-    cmd->add_option("--port", o->server.port, "TCP port (0: any free one)")
-        ->check(CLI::Range(0, 65535))
-        ->capture_default_str();
+    addNumberOption(*cmd, "--port", o->server.port, "TCP port (0: any free one)", 0, 65535);
     cmd->add_option("--bind", o->server.bind,
                     "Address to listen on (this machine only unless you change it)")
         ->capture_default_str();

@@ -1,6 +1,5 @@
 // lipsync eval: how well `analyze` agrees with reference labels over a corpus, and how well a
 // puppet's jaw follows the speech, per file and per speaker (the worst speaker is the figure).
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <lipsyncd/dsp.hpp>
@@ -160,7 +159,7 @@ struct Evaluator {
                     : std::nullopt;
         auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
                                   o.frontEnd.decode(), std::nullopt);
-        for (const auto& w : a.warnings) std::cerr << "lipsync eval: warning: " << w << '\n';
+        printWarnings("eval", a.warnings);
         if (speaker && wordsBeside(item.audio)) align(item, speaker);
         return {std::move(a.schedule), std::move(a.levels)};
     }
@@ -170,10 +169,8 @@ struct Evaluator {
         const auto dir = std::filesystem::path(o.schedules) / item.speaker;
         std::error_code ec;
         std::filesystem::create_directories(dir, ec);
-        const auto file = dir / (item.name + ".tsv");
-        std::ofstream out(file);
-        if (!out) throw InputError("--schedules: cannot write " + file.string());
-        writeSchedule(out, hypothesis);
+        withOutputStream((dir / (item.name + ".tsv")).string(),
+                         [&](std::ostream& out) { writeSchedule(out, hypothesis); });
     }
 
     Score scoreFile(const CorpusItem& item) const {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "NameValue.hpp"
+#include "NumberOption.hpp"
 
 namespace lipsyncd::cli {
 
@@ -39,35 +40,35 @@ struct FrontEndOptions {
                        "16 kHz); high, veryhigh: libsoxr's steeper filters")
             ->check(CLI::IsMember({"low", "medium", "high", "veryhigh"}))
             ->capture_default_str();
-        // A number within [lo, hi], its default shown.
-        const auto number = [&](const std::string& name, auto& field, const std::string& text,
-                                double lo, double hi) {
-            cmd.add_option(name, field, text)->check(CLI::Range(lo, hi))->capture_default_str();
-        };
         // Shorter runs are flicker and merge into their neighbour; longer holds mean fewer,
         // steadier segments and a longer streaming delay (the longest minimum plus a hop).
-        number("--min-vowel", segmenter.minVowelSeconds, "Shortest vowel segment, seconds", 0.0,
-               0.5);
-        number("--min-consonant", segmenter.minConsonantSeconds,
-               "Shortest consonant segment, seconds", 0.0, 0.5);
-        number("--min-silence", segmenter.minSilenceSeconds, "Shortest silence, seconds", 0.0, 0.5);
-        number("--silence-below-peak", classifier.silenceBelowPeakDb,
-               "Frames this many dB below the recent speech peak are silence, whatever the noise "
-               "floor (0: off)",
-               0.0, 80.0);
-        number("--jaw-spread", classifier.jawSpreadDb,
-               "How far (dB of spectral distance) a class may lie from the nearest and still "
-               "count towards the jaw height heard in a frame",
-               0.01, 20.0);
-        number("--class-network-db", classifier.classNetworkDb,
-               "With a template set that has a class network: dB of distance added per nat a "
-               "class's likelihood lies below the likeliest class's (0: the templates alone)",
-               0.0, 20.0);
-        number("--class-prior-scale", classifier.classPriorScale,
-               "With a class network: how much of each class's share of the training frames its "
-               "posterior is divided by (1: all, the hybrid's scaled likelihood; 0: none, common "
-               "classes favoured)",
-               0.0, 1.0);
+        addNumberOption(cmd, "--min-vowel", segmenter.minVowelSeconds,
+                        "Shortest vowel segment, seconds", 0.0, 0.5);
+        addNumberOption(cmd, "--min-consonant", segmenter.minConsonantSeconds,
+                        "Shortest consonant segment, seconds", 0.0, 0.5);
+        addNumberOption(cmd, "--min-silence", segmenter.minSilenceSeconds,
+                        "Shortest silence, seconds", 0.0, 0.5);
+        addNumberOption(
+            cmd, "--silence-below-peak", classifier.silenceBelowPeakDb,
+            "Frames this many dB below the recent speech peak are silence, whatever the noise "
+            "floor (0: off)",
+            0.0, 80.0);
+        addNumberOption(
+            cmd, "--jaw-spread", classifier.jawSpreadDb,
+            "How far (dB of spectral distance) a class may lie from the nearest and still "
+            "count towards the jaw height heard in a frame",
+            0.01, 20.0);
+        addNumberOption(
+            cmd, "--class-network-db", classifier.classNetworkDb,
+            "With a template set that has a class network: dB of distance added per nat a "
+            "class's likelihood lies below the likeliest class's (0: the templates alone)",
+            0.0, 20.0);
+        addNumberOption(
+            cmd, "--class-prior-scale", classifier.classPriorScale,
+            "With a class network: how much of each class's share of the training frames its "
+            "posterior is divided by (1: all, the hybrid's scaled likelihood; 0: none, common "
+            "classes favoured)",
+            0.0, 1.0);
         cmd.add_option("--class-bias", classBias,
                        "dB added to a class's distance, CLASS=DB (repeatable; over the template "
                        "set's class_bias_db, a negative value favours the class)");
@@ -81,10 +82,8 @@ struct FrontEndOptions {
         // the frames after it before its class is decided.
         cmd.add_flag("!--no-decoder", decoder.enabled,
                      "Classify frame by frame (no Viterbi decoding over classes)");
-        cmd.add_option("--lag", decoder.lagSeconds,
-                       "Decoder lag, seconds: how long a frame waits for later frames")
-            ->check(CLI::Range(0.0, 2.0))
-            ->capture_default_str();
+        addNumberOption(cmd, "--lag", decoder.lagSeconds,
+                        "Decoder lag, seconds: how long a frame waits for later frames", 0.0, 2.0);
         cmd.add_flag_callback(
             "--offline", [this] { decoder.lagSeconds = -1; },
             "Decode offline: every frame decided from the whole input (files only)");

@@ -3,6 +3,7 @@
 
 #include "Commands.hpp"
 #include "Corpus.hpp"
+#include "NumberOption.hpp"
 #include "Output.hpp"
 #include "PoseTrackSvg.hpp"
 
@@ -22,9 +23,8 @@ void addPlotCommand(CLI::App& app) {
     cmd->add_option("--labels", o->labels, "Schedule alphabet (as for animate)")
         ->capture_default_str();
     cmd->add_option("-o,--output", o->output, "SVG file to write ('-' for stdout)")->required();
-    cmd->add_option("--pixels-per-second", o->chart.pixelsPerSecond, "Horizontal scale")
-        ->check(CLI::Range(10.0, 5000.0))
-        ->capture_default_str();
+    addNumberOption(*cmd, "--pixels-per-second", o->chart.pixelsPerSecond, "Horizontal scale", 10.0,
+                    5000.0);
     cmd->callback([o] {
         const auto track = readPoseTrackCsvFile(o->weights);
         std::optional<PhonemeSchedule> schedule;

@@ -6,6 +6,7 @@
 #include <lipsyncd/lipsync.hpp>
 #include <string>
 
+#include "NumberOption.hpp"
 #include "Output.hpp"
 
 namespace lipsyncd::cli {
@@ -35,9 +36,8 @@ struct RuntimeOptions {
             ->capture_default_str();
         cmd.add_option("--character", spec.character,
                        "Character file: a base curve set with some bigrams replaced");
-        cmd.add_option("--weights-rate", spec.config.outputRate, "Pose-weight frames per second")
-            ->check(CLI::Range(1.0, 1000.0))
-            ->capture_default_str();
+        addNumberOption(cmd, "--weights-rate", spec.config.outputRate,
+                        "Pose-weight frames per second", 1.0, 1000.0);
         cmd.add_flag("!--no-smoothing", spec.config.smoothing,
                      "Skip valley smoothing (for comparison)");
         cmd.add_flag("!--no-constraints", spec.config.constraints, "Skip pose-pair constraints");

@@ -31,7 +31,7 @@ void runSay(const SayOptions& o) {
     if (!o.raw) {
         std::vector<std::string> warnings;
         schedule = mapSchedule(speech.phonemes, espeakMapForVoice(o.voice), &warnings);
-        for (const auto& w : warnings) std::cerr << "lipsync say: warning: " << w << '\n';
+        printWarnings("say", warnings);
     }
     if (!o.schedule.empty())
         withOutputStream(o.schedule,

@@ -6,6 +6,8 @@
 
 #include "Commands.hpp"
 #include "Corpus.hpp"
+#include "NumberOption.hpp"
+#include "Output.hpp"
 
 namespace lipsyncd::cli {
 
@@ -71,7 +73,7 @@ void runTrain(TrainOptions o) {
             const auto labels = readLabels(item.labels, o.labels);
             std::vector<std::string> warnings;
             const auto frames = dsp::analyzeFrames(item.audio, o.training.analysis, {}, &warnings);
-            for (const auto& w : warnings) std::cerr << "lipsync train: warning: " << w << '\n';
+            printWarnings("train", warnings);
             trainer.addUtterance(frames, labels);
             seconds += frames.size() * o.training.analysis.hopSeconds;
             if (++files % 50 == 0)
@@ -123,35 +125,26 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_option("--labels", o->labels,
                     "Label alphabet: auto, common, arpabet, or a map name/file")
         ->capture_default_str();
-    cmd->add_option("--clusters", o->training.clustersPerClass, "Cluster means per class")
-        ->check(CLI::Range(1, 64))
-        ->capture_default_str();
+    addNumberOption(*cmd, "--clusters", o->training.clustersPerClass, "Cluster means per class", 1,
+                    64);
     cmd->add_flag("--full-covariance", o->training.fullCovariance,
                   "Match under the pooled within-class covariance of all features (a Mahalanobis "
                   "distance, stored as the set's 'whitening') instead of per-feature weights");
-    cmd->add_option("--jaw-hidden", o->training.jawHiddenUnits,
+    addNumberOption(*cmd, "--jaw-hidden", o->training.jawHiddenUnits,
                     "Hidden units of the jaw network trained beside the templates (the jaw heard "
-                    "from each frame); 0: none, the jaw comes from the class distances")
-        ->check(CLI::Range(0, 256))
-        ->capture_default_str();
-    cmd->add_option("--jaw-epochs", o->training.jawEpochs, "Passes of the jaw network's training")
-        ->check(CLI::Range(1, 100))
-        ->capture_default_str();
-    cmd->add_option("--class-hidden", o->training.classHiddenUnits,
+                    "from each frame); 0: none, the jaw comes from the class distances",
+                    0, 256);
+    addNumberOption(*cmd, "--jaw-epochs", o->training.jawEpochs,
+                    "Passes of the jaw network's training", 1, 100);
+    addNumberOption(*cmd, "--class-hidden", o->training.classHiddenUnits,
                     "Hidden units of the class network trained beside the templates (scaled "
-                    "class likelihoods added to the template distances); 0: none")
-        ->check(CLI::Range(0, 256))
-        ->capture_default_str();
-    cmd->add_option("--class-epochs", o->training.classEpochs,
-                    "Passes of the class network's training")
-        ->check(CLI::Range(1, 100))
-        ->capture_default_str();
-    cmd->add_option("--order", o->training.analysis.order, "LPC order")
-        ->check(CLI::Range(2, dsp::kMaxOrder))
-        ->capture_default_str();
-    cmd->add_option("--bins", o->training.analysis.spectrumBins, "Spectrum points 0..rate/2")
-        ->check(CLI::Range(4, 512))
-        ->capture_default_str();
+                    "class likelihoods added to the template distances); 0: none",
+                    0, 256);
+    addNumberOption(*cmd, "--class-epochs", o->training.classEpochs,
+                    "Passes of the class network's training", 1, 100);
+    addNumberOption(*cmd, "--order", o->training.analysis.order, "LPC order", 2, dsp::kMaxOrder);
+    addNumberOption(*cmd, "--bins", o->training.analysis.spectrumBins, "Spectrum points 0..rate/2",
+                    4, 512);
     cmd->add_option("--extra-features", o->extraFeatures,
                     "Features after the spectrum: log_error, level (comma list, or 'none')")
         ->delimiter(',')
@@ -159,11 +152,10 @@ void addTrainCommand(CLI::App& app) {
     cmd->add_flag("--normalise-channel", o->normaliseChannel,
                   "Subtract a running mean spectrum (channel and speaker normalisation), starting "
                   "from the training speech's mean, which the set stores");
-    cmd->add_option("--mean-prior", o->training.analysis.meanPriorSeconds,
+    addNumberOption(*cmd, "--mean-prior", o->training.analysis.meanPriorSeconds,
                     "With --normalise-channel: seconds of speech the training mean counts for "
-                    "before a voice's own mean takes over")
-        ->check(CLI::Range(0.1, 600.0))
-        ->capture_default_str();
+                    "before a voice's own mean takes over",
+                    0.1, 600.0);
     cmd->add_option("--keep-templates", o->keepTemplates,
                     "Train only the networks (the jaw network, and the class network with "
                     "--class-hidden; --jaw-hidden 0 keeps the set's jaw network): write this "
