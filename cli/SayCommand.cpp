@@ -54,7 +54,8 @@ void addSayCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voice,
                     "espeak-ng voice, variants with '+' (en-us+f2); its language needs a "
                     "phoneme map, config/phonemes/espeak-LANG.toml (en, fr, es, ru, bg, ro, cs, "
-                    "nl, ca, be, el, da)")
+                    "nl, ca, be, el, da; made from espeak-ng's IPA: de, it, pt, pl, sv, nb, fi, "
+                    "hu, tr, uk, sk, hr)")
         ->capture_default_str();
     cmd->add_option("--rate", o->rate, "Words per minute (default: the voice's)")
         ->check(CLI::Range(80, 450));

@@ -166,6 +166,50 @@ TEST(EspeakSynthesizer, WordsInOtherLanguagesTakeTheMouthTheirSoundsNeed) {
               (std::vector<std::string>{"z", "ah", "r", "ao", "kg"}));
 }
 
+// German, Italian, Portuguese, Polish, Swedish, Norwegian, Finnish, Hungarian, Turkish,
+// Ukrainian, Slovak and Croatian have maps made from espeak-ng's own IPA
+// (scripts/make-phoneme-maps.py): the same mouth rules hold through them.
+TEST(EspeakSynthesizer, LanguagesWithGeneratedMapsTakeTheMouthTheirSoundsNeed) {
+    const std::vector<std::string> mama{"bmp", "aa", "bmp", "aa"};
+    for (const std::string voice : {"de", "it", "pl", "uk"})
+        EXPECT_EQ(classesOf(voice == "uk" ? "мама" : "mama", voice, 0), mama) << voice;
+    EXPECT_EQ(classesOf("Pferd", "de", 0), (std::vector<std::string>{"bmp", "eh", "r", "d"}));
+    EXPECT_EQ(classesOf("Fuß", "de", 0), (std::vector<std::string>{"f", "w", "z"}));
+    EXPECT_EQ(classesOf("schön", "de", 0), (std::vector<std::string>{"sh", "ow", "d"}));
+    EXPECT_EQ(classesOf("fuoco", "it", 0), (std::vector<std::string>{"f", "w", "ao", "kg", "ow"}));
+    EXPECT_EQ(classesOf("obrigado", "pt", 0),  // O b r i g a d u
+              (std::vector<std::string>{"ao", "bmp", "r", "ih", "kg", "aa", "d", "w"}));
+    EXPECT_EQ(classesOf("obrigado", "pt-br", 0).front(), "ow");  // Brazil: a closer o
+    EXPECT_EQ(classesOf("wąż", "pl", 0), (std::vector<std::string>{"f", "ao", "sh"}));
+    EXPECT_EQ(classesOf("mjölk", "sv", 0),
+              (std::vector<std::string>{"bmp", "sh", "ow", "l", "kg"}));
+    EXPECT_EQ(classesOf("hus", "nb", 0), (std::vector<std::string>{"h", "w", "z"}));
+    EXPECT_EQ(classesOf("köszönöm", "hu", 0).back(), "bmp");
+    EXPECT_EQ(classesOf("hvala", "hr", 0), (std::vector<std::string>{"kg", "f", "aa", "l", "ah"}));
+    for (const auto& [voice, text] : std::vector<std::pair<std::string, std::string>>{
+             {"fi", "Hyvää päivää, kiitos paljon."},
+             {"tr", "Günaydın çocuklar, nasılsınız?"},
+             {"sk", "Ďakujem, dovidenia, mäso a kôra."}}) {
+        std::vector<std::string> warnings;
+        const auto script =
+            scriptForText(synthesizer(), text, voice, espeakMapForVoice(voice), &warnings);
+        EXPECT_GE(script.size(), 3u) << voice;
+        EXPECT_TRUE(warnings.empty()) << voice << ": " << warnings.front();
+    }
+}
+
+// A voice whose language has no map is an error that names the maps there are.
+TEST(EspeakSynthesizer, AVoiceWithoutAMapNamesTheLanguagesThatHaveOne) {
+    try {
+        espeakMapForVoice("ko");
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("espeak-ko.toml"), std::string::npos) << what;
+        EXPECT_NE(what.find("de, el, en"), std::string::npos) << what;
+    }
+}
+
 // French espeak-ng says "tout le monde" as one dictionary entry, one word event whose length
 // covers "tout": the word list named "tout" for all three words' sounds.
 TEST(EspeakSynthesizer, WordsEspeakSaysAsOneAreNamedTogether) {

@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <filesystem>
 #include <lipsyncd/tts.hpp>
 
 namespace lipsyncd {
@@ -36,6 +38,23 @@ PhonemeSchedule mapSchedule(const PhonemeSchedule& raw, const PhonemeMap& map,
     return out;
 }
 
+namespace {
+// "de, en, fr, ...": the languages of the espeak-LANG.toml files in `folder`, sorted.
+std::string languagesWithMaps(const std::filesystem::path& folder) {
+    std::vector<std::string> languages;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+        const auto stem = entry.path().stem().string();
+        if (entry.path().extension() == ".toml" && stem.rfind("espeak-", 0) == 0)
+            languages.push_back(stem.substr(7));
+    }
+    std::sort(languages.begin(), languages.end());
+    std::string out;
+    for (const auto& l : languages) out += (out.empty() ? "" : ", ") + l;
+    return out.empty() ? "no language" : out;
+}
+}  // namespace
+
 PhonemeMap espeakMapForVoice(const std::string& voice) {
     // "en-us+f2" -> language "en"; "cmn" -> "cmn".
     std::string language = voice.substr(0, voice.find('+'));
@@ -44,7 +63,8 @@ PhonemeMap espeakMapForVoice(const std::string& voice) {
     const auto file = dataDirectory() / "phonemes" / (name + ".toml");
     if (!std::filesystem::exists(file))
         throw InputError("voice '" + voice + "': no phoneme map for language '" + language +
-                         "' (expected " + file.string() + ")");
+                         "' (expected " + file.string() + "; there are maps for " +
+                         languagesWithMaps(file.parent_path()) + ")");
     return PhonemeMap::load(file);
 }
 
