@@ -135,32 +135,43 @@ struct Evaluator {
     std::pair<PhonemeSchedule, LevelTrack> schedule(const CorpusItem& item) const {
         dsp::SpeakerAdaptation* speaker = nullptr;
         if (o.adaptSpeaker) speaker = &speakers.try_emplace(item.speaker, templates).first->second;
-        if (!o.align) return analyse(item, speaker);
-        auto r = align(item, speaker);
-        return {std::move(r.schedule), std::move(r.levels)};
+        if (!o.align) return analyse(item, speaker, true);
+        if (auto r = align(item, speaker)) return {std::move(r->schedule), std::move(r->levels)};
+        return analyse(item, speaker, false);
     }
 
-    dsp::AlignFileResult align(const CorpusItem& item, dsp::SpeakerAdaptation* speaker) const {
-        auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
-                           voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner.config,
-                           o.frontEnd.decode(), std::nullopt, o.aligner.reductions, speaker);
-        for (const auto& w : r.warnings)
-            std::cerr << "lipsync eval: " << item.speaker << '/' << item.name << ": " << w << '\n';
-        return r;
+    // Words that cannot be aligned at all (none the voice can read, say) leave the file to the
+    // audio alone, as the service does with such a file, and the run goes on.
+    std::optional<dsp::AlignFileResult> align(const CorpusItem& item,
+                                              dsp::SpeakerAdaptation* speaker) const {
+        const auto where = "lipsync eval: " + item.speaker + '/' + item.name + ": ";
+        try {
+            auto r =
+                alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
+                          voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner.config,
+                          o.frontEnd.decode(), std::nullopt, o.aligner.reductions, speaker);
+            for (const auto& w : r.warnings) std::cerr << where << w << '\n';
+            return r;
+        } catch (const InputError& e) {
+            std::cerr << where << "words not used: " << e.what() << "; audio-only analysis\n";
+            return std::nullopt;
+        }
     }
 
     // From the audio alone; with a speaker (the service's adapt_speaker), on the voice its
-    // earlier files taught, and then the file's words teach it in turn, as a line played with
-    // its words does: what the service makes of a file without words at that point of a show.
+    // earlier files taught, and then (`teach`: not when aligning them just failed) the file's
+    // words teach it in turn, as a line played with its words does: what the service makes of
+    // a file without words at that point of a show.
     std::pair<PhonemeSchedule, LevelTrack> analyse(const CorpusItem& item,
-                                                   dsp::SpeakerAdaptation* speaker) const {
+                                                   dsp::SpeakerAdaptation* speaker,
+                                                   bool teach) const {
         const auto own =
             speaker ? speaker->adaptedIfHeard(o.aligner.config.speakerAdaptationPriorFrames)
                     : std::nullopt;
         auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
                                   o.frontEnd.decode(), std::nullopt);
         printWarnings("eval", a.warnings);
-        if (speaker && wordsBeside(item.audio)) align(item, speaker);
+        if (teach && speaker && wordsBeside(item.audio)) align(item, speaker);
         return {std::move(a.schedule), std::move(a.levels)};
     }
 

@@ -53,9 +53,9 @@ void addSayCommand(CLI::App& app) {
     cmd->add_option("text", o->text, "What to say")->required();
     cmd->add_option("--voice", o->voice,
                     "espeak-ng voice, variants with '+' (en-us+f2); its language needs a "
-                    "phoneme map, config/phonemes/espeak-LANG.toml (en, fr, es, ru, bg, ro, cs, "
-                    "nl, ca, be, el, da; made from espeak-ng's IPA: de, it, pt, pl, sv, nb, fi, "
-                    "hu, tr, uk, sk, hr)")
+                    "phoneme map, config/phonemes/espeak-LANG.toml: 50 languages (en, fr, es, "
+                    "ru, bg, ro, cs, nl, ca, be, el, da by hand; de, it, pt, pl, sv, nb, fi, hu, "
+                    "tr, uk, sk, hr, hi, ko, id, vi, ... from espeak-ng's IPA)")
         ->capture_default_str();
     cmd->add_option("--rate", o->rate, "Words per minute (default: the voice's)")
         ->check(CLI::Range(80, 450));

@@ -54,17 +54,21 @@ def coverage_lines():
         if not line.strip() or line.startswith("#"):
             continue
         voice, sep, text = line.partition("\t")
-        if not sep or not text.strip():
-            sys.exit(f"{COVERAGE}:{number}: expected VOICE<TAB>text")
-        out[voice.split("-")[0]].append((voice, text))
+        if not voice.strip() or " " in voice or (sep and not text.strip()):
+            sys.exit(f"{COVERAGE}:{number}: expected VOICE<TAB>text, or VOICE alone")
+        out[voice.split("-")[0]].append((voice, text.strip()))
     return out
 
 
 def read(voice, text, ipa):
     """espeak-ng's reading: a list of words, each a list of phoneme tokens."""
     mode = ["--ipa"] if ipa else ["-x"]
-    out = subprocess.run(["espeak-ng", "-q", *mode, "--sep=|", "-v", voice, text],
-                         capture_output=True, text=True, check=True).stdout
+    run = subprocess.run(["espeak-ng", "-q", *mode, "--sep=|", "-v", voice, text],
+                         capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit(f"make-phoneme-maps: {COVERAGE}: espeak-ng cannot read with voice '{voice}' "
+                 f"({run.stderr.strip() or 'exit ' + str(run.returncode)})")
+    out = run.stdout
     return [word.split("|") for word in out.split()]
 
 
@@ -172,7 +176,8 @@ def class_of(ipa, table):
 def make_map(language, lines, table):
     votes = collections.defaultdict(collections.Counter)
     unpaired = 0
-    texts = list(lines) + [(lines[0][0], " ".join(str(n) for n in list(range(101)) + [1000]))]
+    numbers = " ".join(str(n) for n in list(range(101)) + [1000])
+    texts = [(voice, text) for voice, text in lines if text] + [(lines[0][0], numbers)]
     for voice, text in texts:
         found, skipped = pairs(voice, text)
         unpaired += skipped
@@ -213,26 +218,13 @@ def make_map(language, lines, table):
     return entries, silent, unpaired
 
 
-def language_names(voice):
-    """The names espeak-ng's language switches give the voice's language: its Language column
-    and its Other Languages in `espeak-ng --voices=VOICE` ("pt" is also "pt-pt")."""
-    listing = subprocess.run(["espeak-ng", f"--voices={voice}"], capture_output=True,
-                             text=True).stdout.splitlines()[1:]
-    for row in listing:
-        fields = row.split()
-        if len(fields) > 1 and fields[1] == voice:
-            return [fields[1]] + re.findall(r"\(([\w-]+) \d+\)", row)
-    return []
-
-
 def quoted(s):
     return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
 def render_map(language, voices, entries, silent):
     """The map file's text."""
-    names = sorted({language, *voices, *(n for v in voices for n in language_names(v))} - {"en"})
-    marks = ["'", ",", ";", "%", "=", "|", "||", "!", "(en)"] + [f"({n})" for n in names]
+    marks = ["'", ",", ";", "%", "=", "|", "||", "!"]  # language switches, "(en)": any map
     body = [f"{MARK} (do not edit: change config/phonemes/ipa-multilingual.toml",
             "# or config/corpus/phoneme-coverage.txt and run it again).",
             f"# espeak-ng's phoneme mnemonics for {', '.join(voices)} onto the Common Phoneme Set,",
@@ -240,8 +232,8 @@ def render_map(language, voices, entries, silent):
             f'name = "espeak-{language}"',
             f'description = "espeak-ng {language} phoneme mnemonics (generated from their IPA)"',
             "case_sensitive = true",
-            "# Ignored: stress and other marks, language switches (a word read as English: the",
-            "# fallback names its phonemes) and the phonemes espeak-ng writes no IPA for.",
+            "# Ignored: stress and other marks, and the phonemes espeak-ng writes no IPA for. (A",
+            "# language switch, \"(en)\", is ignored by every map; the fallback names English phonemes.)",
             "ignore = [" + ", ".join(quoted(m) for m in marks + silent) + "]",
             'fallback = "espeak-en"',
             "",

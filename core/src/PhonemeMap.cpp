@@ -91,6 +91,9 @@ std::optional<PhonemeMap::Result> PhonemeMap::map(std::string_view symbol) const
 }
 
 bool PhonemeMap::isIgnored(std::string_view symbol) const {
+    // A name in parentheses is espeak-ng's switch of language ("(en)" before an English word in
+    // a French line, "(de)" in a Croatian one): never a sound, in whatever map.
+    if (symbol.size() > 2 && symbol.front() == '(' && symbol.back() == ')') return true;
     const std::string key = normalise(symbol);
     return std::find(ignored_.begin(), ignored_.end(), key) != ignored_.end();
 }

@@ -230,6 +230,35 @@ TEST(LipsyncCli, EvalWritesEachFilesScheduleAsScored) {
     EXPECT_NE(refused.err.find(blocked.string()), std::string::npos) << refused.err;
 }
 
+// A file whose words cannot be aligned at all (none the voice can read) is named and scored
+// from the audio alone, as the service plays such a file; the files after it are still aligned.
+TEST(LipsyncCli, EvalScoresAFileWithUnreadableWordsFromTheAudioAndGoesOn) {
+    const auto corpus = scratchDir("cli_eval_unreadable");
+    const auto speaker = corpus / "puppeteer";
+    fs::create_directories(speaker);
+    for (const std::string name : {"a", "b"}) {
+        fs::copy_file(exampleWav(), speaker / (name + ".wav"),
+                      fs::copy_options::overwrite_existing);
+        fs::copy_file(fs::path(exampleWav()).replace_extension(".lab"), speaker / (name + ".lab"),
+                      fs::copy_options::overwrite_existing);
+    }
+    std::ofstream(speaker / "a.txt") << "日本語\n";
+    std::ofstream(speaker / "b.txt") << "Hello puppet, open wide.\n";
+    const auto out = corpus / "out";
+    const auto r =
+        runLipsync({"eval", "--corpus", corpus.string(), "--align", "--schedules", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("puppeteer/a: words not used:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("audio-only analysis"), std::string::npos) << r.err;
+    const auto read = [](const fs::path& file) {
+        std::ifstream in(file);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const auto analyzed = runLipsync({"analyze", (speaker / "a.wav").string(), "-s", "-", "-q"});
+    EXPECT_EQ(read(out / "puppeteer" / "a.tsv"), analyzed.out);
+    EXPECT_NE(read(out / "puppeteer" / "b.tsv"), analyzed.out) << "b was not aligned";
+}
+
 TEST(LipsyncCli, EvalFailsBelowTheFloorAndPassesAboveIt) {
     const auto dir = exampleWav().parent_path();
     EXPECT_EQ(runLipsync({"eval", "--corpus", dir.string(), "--min-accuracy", "0.05"}).exitCode, 0);

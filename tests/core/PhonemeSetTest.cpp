@@ -64,6 +64,19 @@ TEST(PhonemeMap, AFallbackMapFillsOnlyTheNamesTheMapLacks) {
     EXPECT_EQ(PhonemeMap::named("espeak-ru").map("oU")->phoneme, "ow");  // a Latin-script word
 }
 
+// espeak-ng switches language inside a line ("(de)" before a German word in a Croatian one,
+// "(id)" in a Malay one): every map passes over such a mark, listed or not, as it does stress.
+TEST(PhonemeMap, ALanguageSwitchIsAMarkInEveryMap) {
+    for (const std::string name : {"espeak-hr", "espeak-de", "espeak-fr", "arpabet"}) {
+        const auto map = PhonemeMap::named(name);
+        EXPECT_TRUE(map.isIgnored("(de)")) << name;
+        EXPECT_TRUE(map.isIgnored("(pt-pt)")) << name;
+        EXPECT_FALSE(map.isIgnored("()")) << name;
+        EXPECT_FALSE(map.isIgnored("(")) << name;
+    }
+    EXPECT_FALSE(PhonemeMap::named("espeak-de").isIgnored("a"));
+}
+
 TEST(PhonemeMap, AFallbackCycleOrAnotherSetIsAnErrorNamingTheFile) {
     const auto dir = std::filesystem::temp_directory_path();
     const auto a = dir / "lipsyncd_cycle_a.toml", b = dir / "lipsyncd_cycle_b.toml";

@@ -307,6 +307,18 @@ TEST(AlignText, TextInAScriptTheVoiceCannotReadIsAnError) {
     EXPECT_TRUE(warned);
 }
 
+// Accents written as combining marks (decomposed text: "e" + U+0301) are the Latin letter's own:
+// such words are read, not left out as another script.
+TEST(AlignText, DecomposedAccentsAreReadAsTheirLetters) {
+    const auto s = speak(kLine);
+    const auto file = wav("align_nfd.wav", s.samples, s.rate);
+    const auto r = align(file, "Seven puppets sang a song about the moon, cafe\u0301.");
+    for (const auto& w : r.warnings) EXPECT_EQ(w.find("cannot read"), std::string::npos) << w;
+    const auto vi = scriptForText(synth(), "Chie\u0302\u0301c die\u0302\u0300u.", "vi",
+                                  espeakMapForVoice("vi"), nullptr);
+    EXPECT_EQ(vi.size(), 2u);
+}
+
 // A short clip in a noisy room (the room 34 dB under the word, within the 35 dB the speech
 // lies under its peak): the room is not speech, so the speaking rate is the word's own.
 TEST(AlignText, TheRoomOfAShortClipDoesNotCountAsSpeech) {

@@ -24,9 +24,12 @@ std::string languageOf(const std::string& voice) {
 }
 
 // A letter outside Latin (Basic Latin to Latin Extended-B, and Latin Extended Additional);
-// general punctuation and symbols (U+2000..U+2BFF) are not letters.
+// general punctuation and symbols (U+2000..U+2BFF) are not letters, and nor are combining
+// diacritical marks (U+0300..U+036F): text written decomposed (NFD, as macOS files and many
+// Vietnamese texts are) carries its accents as such marks after the Latin letter.
 bool foreignToLatin(char32_t c) {
-    return c >= 0x250 && !(c >= 0x1E00 && c <= 0x1EFF) && !(c >= 0x2000 && c <= 0x2BFF);
+    return c >= 0x250 && !(c >= 0x300 && c <= 0x36F) && !(c >= 0x1E00 && c <= 0x1EFF) &&
+           !(c >= 0x2000 && c <= 0x2BFF);
 }
 
 bool readable(const std::string& word, const std::string& language) {

@@ -100,7 +100,8 @@ class PhonemeMap {
 
     // nullopt for a symbol the map does not know (callers warn, naming it).
     std::optional<Result> map(std::string_view symbol) const;
-    // Marks that are not sounds at all (stress, syllable breaks): callers skip them silently.
+    // Marks that are not sounds at all (stress, syllable breaks, and in any map a name in
+    // parentheses, espeak-ng's switch of language): callers skip them silently.
     bool isIgnored(std::string_view symbol) const;
     const std::string& name() const { return name_; }
     // The phoneme set the map's targets belong to (its `phoneme_set` key; "common" if absent).
