@@ -13,10 +13,10 @@ namespace lipsyncd {
 namespace {
 // Languages written in Latin script. espeak-ng voices for them spell a word in another script
 // letter by letter (or name its characters), which is not what a speaker says.
-constexpr std::array<std::string_view, 36> kLatinScriptLanguages = {
-    "en", "de", "fr", "es", "it", "nl", "pt", "pl", "cs", "sv", "da", "nb",
-    "fi", "hu", "ro", "sk", "sl", "hr", "tr", "id", "ms", "vi", "ca", "eu",
-    "et", "lv", "lt", "af", "sw", "cy", "ga", "is", "sq", "eo", "la", "mt"};
+constexpr std::array<std::string_view, 38> kLatinScriptLanguages = {
+    "en", "de", "fr", "es", "it", "nl", "pt", "pl", "cs", "sv", "da", "nb", "fi",
+    "hu", "ro", "sk", "sl", "hr", "tr", "id", "ms", "vi", "ca", "eu", "et", "lv",
+    "lt", "af", "sw", "cy", "ga", "gd", "an", "is", "sq", "eo", "la", "mt"};
 
 std::string languageOf(const std::string& voice) {
     const auto base = voice.substr(0, voice.find('+'));
