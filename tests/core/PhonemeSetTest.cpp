@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <lipsyncd/core.hpp>
 
@@ -62,6 +63,21 @@ TEST(PhonemeMap, AFallbackMapFillsOnlyTheNamesTheMapLacks) {
     EXPECT_EQ(fr.map("T")->phoneme, "th");
     EXPECT_TRUE(fr.isIgnored("(en)"));
     EXPECT_EQ(PhonemeMap::named("espeak-ru").map("oU")->phoneme, "ow");  // a Latin-script word
+}
+
+// Every espeak-ng map shipped (hand-written or made by scripts/make-phoneme-maps.py) and the IPA
+// table the generated ones come from load, and map onto classes of their phoneme set.
+TEST(PhonemeMap, EveryShippedEspeakMapLoads) {
+    std::size_t maps = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dataDirectory() / "phonemes")) {
+        const auto stem = entry.path().stem().string();
+        if (stem.rfind("espeak-", 0) != 0 && stem != "ipa-multilingual") continue;
+        EXPECT_NO_THROW(PhonemeMap::load(entry.path())) << entry.path();
+        ++maps;
+    }
+    EXPECT_GE(maps, 51u);  // 12 by hand, 38 generated, the IPA table
+    EXPECT_EQ(PhonemeMap::named("espeak-pl").map("S")->phoneme, "sh");
+    EXPECT_EQ(PhonemeMap::named("ipa-multilingual").map("ʏ")->phoneme, "w");
 }
 
 // espeak-ng switches language inside a line ("(de)" before a German word in a Croatian one,
