@@ -29,16 +29,7 @@ work="$corpus/$voice"
 [ -x "$lipsync" ] || { echo "check-phoneme-map.sh: $lipsync not built (scripts/build.sh)" >&2; exit 1; }
 
 package=tuxpaint-stamps-default
-mkdir -p "$cache/debs" "$cache/root"
-if [ ! -e "$cache/root/.$package" ]; then
-  ls "$cache/debs/${package}_"*.deb >/dev/null 2>&1 ||
-    (cd "$cache/debs" && apt-get download -q "$package" >/dev/null 2>&1) || {
-      echo "check-phoneme-map.sh: cannot download $package (apt-get download)" >&2
-      exit 77
-    }
-  dpkg -x "$cache/debs/${package}_"*.deb "$cache/root"
-  touch "$cache/root/.$package"
-fi
+"$here/scripts/fetch-packages.sh" "$cache" "$package"
 
 rm -rf "$corpus" && mkdir -p "$work"
 find "$cache/root/usr/share/tuxpaint/stamps" -name '*.txt' -print0 |

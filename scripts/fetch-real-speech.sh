@@ -61,14 +61,6 @@ done
 [ -f /usr/share/pocketsphinx/model/en-us/cmudict-en-us.dict ] ||
   unavailable "the pocketsphinx-en-us model is not installed (apt-get install pocketsphinx-en-us)"
 
-mkdir -p "$cache/debs" "$cache/root"
-for p in "${packages[@]}"; do
-  [ -e "$cache/root/.$p" ] && continue
-  ls "$cache/debs/${p}_"*.deb >/dev/null 2>&1 ||
-    (cd "$cache/debs" && apt-get download -q "$p" >/dev/null 2>&1) ||
-    unavailable "cannot download $p (apt-get download; is apt reachable and its lists updated?)"
-  dpkg -x "$cache/debs/${p}_"*.deb "$cache/root"
-  touch "$cache/root/.$p"
-done
+[ ${#packages[@]} -eq 0 ] || "$here/scripts/fetch-packages.sh" "$cache" "${packages[@]}"
 
 python3 "$here/scripts/label-real-speech.py" "$cache/root" "$out" "$@"
