@@ -42,6 +42,7 @@ constexpr double kWarpMargin = 0.01;
 // A recording with its words, aligned on them.
 struct ReadRecording {
     std::filesystem::path audio;
+    std::string words;  // NAME.txt beside it
     PhonemeSchedule schedule;
 };
 
@@ -90,14 +91,15 @@ std::vector<ReadRecording> alignReadSpeech(const CalibrateOptions& o, const dsp:
         const auto words = wordsBeside(entry.path());
         if (!words) continue;
         if (!synth) synth.emplace();
-        const auto aligned = alignText(*synth, entry.path(), readTextFile(*words), o.voice, base);
+        auto text = readTextFile(*words);
+        const auto aligned = alignText(*synth, entry.path(), text, o.voice, base);
         if (aligned.fellBack || !aligned.warnings.empty()) {
             std::cerr << "lipsync calibrate: skipped " << entry.path().string() << ": "
                       << (aligned.warnings.empty() ? "not aligned" : aligned.warnings.front())
                       << '\n';
             continue;
         }
-        read.push_back({entry.path(), aligned.schedule});
+        read.push_back({entry.path(), std::move(text), aligned.schedule});
     }
     std::sort(read.begin(), read.end(),
               [](const auto& a, const auto& b) { return a.audio < b.audio; });
@@ -168,8 +170,7 @@ dsp::TemplateSet adaptToReadSpeech(const CalibrateOptions& o,
                                    const dsp::TemplateSet& base, EspeakSynthesizer& synth) {
     dsp::SpeakerAdaptation voice(base);
     for (const auto& r : read)
-        alignText(synth, r.audio, readTextFile(*wordsBeside(r.audio)), o.voice, base, {}, {}, {},
-                  std::nullopt, true, &voice);
+        alignText(synth, r.audio, r.words, o.voice, base, {}, {}, {}, std::nullopt, true, &voice);
     std::cerr << "lipsync calibrate: read speech: " << read.size() << " recording(s), "
               << voice.frames() << " frames learnt (prior " << o.priorFrames << " frames)\n";
     return voice.adapted(o.priorFrames);
