@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <lipsyncd/core.hpp>
 #include <lipsyncd/dsp.hpp>
 #include <nlohmann/json.hpp>
@@ -95,11 +94,6 @@ TEST(AlignCli, TheLabellingScriptKeepsOnlyConfidentLabels) {
     const auto usage =
         runProgram("/bin/bash", {LIPSYNCD_SOURCE_DIR "/scripts/label-with-aligner.sh"});
     EXPECT_EQ(usage.exitCode, 2);
-}
-
-std::string slurp(const fs::path& file) {
-    std::ifstream in(file);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 // `align --speaker FILE`: a show's lines aligned one run at a time carry the voice in a file,

@@ -205,23 +205,19 @@ TEST(LipsyncCli, EvalWritesEachFilesScheduleAsScored) {
     std::ofstream(speaker / "hello.txt") << "Hello puppet, open wide.\n";
     const auto out = corpus / "out";
     const auto written = (out / "puppeteer" / "hello.tsv").string();
-    const auto read = [](const std::string& file) {
-        std::ifstream in(file);
-        return std::string(std::istreambuf_iterator<char>(in), {});
-    };
     const auto audioOnly =
         runLipsync({"eval", "--corpus", corpus.string(), "--schedules", out.string()});
     ASSERT_EQ(audioOnly.exitCode, 0) << audioOnly.err;
     const auto analyzed =
         runLipsync({"analyze", (speaker / "hello.wav").string(), "-s", "-", "-q"});
-    EXPECT_EQ(read(written), analyzed.out);
+    EXPECT_EQ(slurp(written), analyzed.out);
     const auto aligned =
         runLipsync({"eval", "--corpus", corpus.string(), "--align", "--schedules", out.string()});
     ASSERT_EQ(aligned.exitCode, 0) << aligned.err;
     const auto byAlign = runLipsync({"align", (speaker / "hello.wav").string(), "--text-file",
                                      (speaker / "hello.txt").string(), "-s", "-", "-q"});
-    EXPECT_EQ(read(written), byAlign.out);
-    EXPECT_NE(read(written), analyzed.out);
+    EXPECT_EQ(slurp(written), byAlign.out);
+    EXPECT_NE(slurp(written), analyzed.out);
     const auto blocked = corpus / "blocked";
     std::ofstream(blocked) << "a file where a folder should be\n";
     const auto refused =
@@ -250,13 +246,9 @@ TEST(LipsyncCli, EvalScoresAFileWithUnreadableWordsFromTheAudioAndGoesOn) {
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("puppeteer/a: words not used:"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("audio-only analysis"), std::string::npos) << r.err;
-    const auto read = [](const fs::path& file) {
-        std::ifstream in(file);
-        return std::string(std::istreambuf_iterator<char>(in), {});
-    };
     const auto analyzed = runLipsync({"analyze", (speaker / "a.wav").string(), "-s", "-", "-q"});
-    EXPECT_EQ(read(out / "puppeteer" / "a.tsv"), analyzed.out);
-    EXPECT_NE(read(out / "puppeteer" / "b.tsv"), analyzed.out) << "b was not aligned";
+    EXPECT_EQ(slurp(out / "puppeteer" / "a.tsv"), analyzed.out);
+    EXPECT_NE(slurp(out / "puppeteer" / "b.tsv"), analyzed.out) << "b was not aligned";
 }
 
 TEST(LipsyncCli, EvalFailsBelowTheFloorAndPassesAboveIt) {
