@@ -102,25 +102,21 @@ void ClassNetwork::validate(std::size_t features, const std::string& source) con
     }
 }
 
-ClassNetwork trainClassNetwork(std::span<const float> inputs, std::span<const std::uint16_t> labels,
-                               std::span<const std::string> classes, std::size_t features,
-                               int hiddenUnits, int epochs, std::uint32_t seed) {
-    const std::size_t rows = labels.size(), count = classes.size();
-    if (features == 0 || rows == 0 || inputs.size() != rows * features || hiddenUnits <= 0)
-        throw InputError("class network: no training frames");
-    std::vector<double> frames(count, 0.0);
-    for (auto l : labels) {
-        if (l >= count) throw InputError("class network: a frame's class is out of range");
-        frames[l] += 1;
-    }
-    // Cross-entropy through the softmax: d/dz_c = p_c − [c is the frame's class].
-    auto layers = network::trainLayers(
-        inputs, rows, features, static_cast<std::size_t>(hiddenUnits), count, epochs, seed, 1.0f,
-        [&](std::size_t row, std::span<const float> z, std::span<float> dz) {
-            const float norm = logSumExp(z);
-            for (std::size_t c = 0; c < count; ++c) dz[c] = std::exp(z[c] - norm);
-            dz[labels[row]] -= 1.0f;
-        });
+namespace {
+// The stored network in training's layout (output weights output by output).
+network::TrainedLayers layersOf(const ClassNetwork& net) {
+    network::TrainedLayers layers{
+        net.inputMean, net.inputScale, net.hiddenWeights, net.hiddenBias, {}, net.outputBias};
+    const std::size_t units = net.hiddenUnits(), count = net.classes.size();
+    layers.outputWeights.assign(count, std::vector<float>(units));
+    for (std::size_t h = 0; h < units; ++h)
+        for (std::size_t c = 0; c < count; ++c)
+            layers.outputWeights[c][h] = net.outputWeights[h][c];
+    return layers;
+}
+
+// Trained layers as a network over `classes` (its priors left to the caller).
+ClassNetwork networkOf(network::TrainedLayers layers, std::span<const std::string> classes) {
     ClassNetwork net;
     net.classes.assign(classes.begin(), classes.end());
     net.inputMean = std::move(layers.inputMean);
@@ -128,15 +124,60 @@ ClassNetwork trainClassNetwork(std::span<const float> inputs, std::span<const st
     net.hiddenWeights = std::move(layers.hiddenWeights);
     net.hiddenBias = std::move(layers.hiddenBias);
     // Stored unit by unit (ClassNetwork::outputWeights); trained class by class.
-    const auto units = static_cast<std::size_t>(hiddenUnits);
+    const std::size_t units = net.hiddenBias.size(), count = classes.size();
     net.outputWeights.assign(units, std::vector<float>(count));
     for (std::size_t c = 0; c < count; ++c)
         for (std::size_t h = 0; h < units; ++h)
             net.outputWeights[h][c] = layers.outputWeights[c][h];
     net.outputBias = std::move(layers.outputBias);
+    return net;
+}
+
+// Cross-entropy through the softmax: d/dz_c = p_c − [c is the frame's class].
+network::TrainedLayers trainOnClasses(std::span<const float> inputs,
+                                      std::span<const std::uint16_t> labels, std::size_t count,
+                                      std::size_t features, std::size_t units, int epochs,
+                                      std::uint32_t seed, const network::TrainingStart& start) {
+    const std::size_t rows = labels.size();
+    if (features == 0 || rows == 0 || inputs.size() != rows * features || units == 0)
+        throw InputError("class network: no training frames");
+    for (auto l : labels)
+        if (l >= count) throw InputError("class network: a frame's class is out of range");
+    return network::trainLayers(
+        inputs, rows, features, units, count, epochs, seed, 1.0f,
+        [&](std::size_t row, std::span<const float> z, std::span<float> dz) {
+            const float norm = logSumExp(z);
+            for (std::size_t c = 0; c < count; ++c) dz[c] = std::exp(z[c] - norm);
+            dz[labels[row]] -= 1.0f;
+        },
+        start);
+}
+}  // namespace
+
+ClassNetwork trainClassNetwork(std::span<const float> inputs, std::span<const std::uint16_t> labels,
+                               std::span<const std::string> classes, std::size_t features,
+                               int hiddenUnits, int epochs, std::uint32_t seed) {
+    const std::size_t rows = labels.size(), count = classes.size();
+    auto net = networkOf(
+        trainOnClasses(inputs, labels, count, features,
+                       static_cast<std::size_t>(std::max(0, hiddenUnits)), epochs, seed, {}),
+        classes);
+    std::vector<double> frames(count, 0.0);
+    for (auto l : labels) frames[l] += 1;
     for (std::size_t c = 0; c < count; ++c)  // a class without frames: as if it had one
         net.logPrior.push_back(
             static_cast<float>(std::log(std::max(1.0, frames[c]) / static_cast<double>(rows))));
+    return net;
+}
+
+ClassNetwork fineTuneClassNetwork(const ClassNetwork& base, std::span<const float> inputs,
+                                  std::span<const std::uint16_t> labels, int epochs, float rate,
+                                  std::uint32_t seed) {
+    const auto start = layersOf(base);
+    auto net = networkOf(trainOnClasses(inputs, labels, base.classes.size(), base.inputMean.size(),
+                                        base.hiddenUnits(), epochs, seed, {&start, rate}),
+                         base.classes);
+    net.logPrior = base.logPrior;
     return net;
 }
 

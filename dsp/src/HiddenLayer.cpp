@@ -6,6 +6,7 @@
 #include <cstring>
 #include <numeric>
 #include <random>
+#include <stdexcept>
 
 #include "VectorLanes.hpp"
 
@@ -31,9 +32,10 @@ float dot(const float* a, const float* b, std::size_t n) {
 // Adam's moments for one block of parameters (Kingma & Ba 2015, algorithm 1).
 struct AdamBlock {
     std::vector<float> m, v;
-    explicit AdamBlock(std::size_t n) : m(n, 0.0f), v(n, 0.0f) {}
+    float rate;
+    AdamBlock(std::size_t n, float stepSize) : m(n, 0.0f), v(n, 0.0f), rate(stepSize) {}
     void step(std::span<float> params, std::span<const float> grad, int t) {
-        constexpr float rate = 1e-3f, beta1 = 0.9f, beta2 = 0.999f, epsilon = 1e-8f;
+        constexpr float beta1 = 0.9f, beta2 = 0.999f, epsilon = 1e-8f;
         const float c1 = 1 - std::pow(beta1, static_cast<float>(t));
         const float c2 = 1 - std::pow(beta2, static_cast<float>(t));
         for (std::size_t i = 0; i < params.size(); ++i) {
@@ -73,6 +75,25 @@ struct Parameters {
         for (auto* g : {&g1, &gb1, &g2, &gb2}) std::fill(g->begin(), g->end(), 0.0f);
     }
 };
+
+// A trained network's standardisation into `net` and its weights into `p` (training's layout).
+void startFrom(const TrainedLayers& from, std::size_t features, std::size_t units,
+               std::size_t outputs, TrainedLayers& net, Parameters& p) {
+    if (from.inputMean.size() != features || from.hiddenBias.size() != units ||
+        from.outputBias.size() != outputs)
+        throw std::invalid_argument("trainLayers: the starting network has other sizes");
+    net.inputMean = from.inputMean;
+    net.inputScale = from.inputScale;
+    p.w1.resize(units * features);
+    for (std::size_t i = 0; i < features; ++i)
+        for (std::size_t h = 0; h < units; ++h) p.w1[h * features + i] = from.hiddenWeights[i][h];
+    p.b1 = from.hiddenBias;
+    p.w2.resize(outputs * units);
+    for (std::size_t o = 0; o < outputs; ++o)
+        std::copy(from.outputWeights[o].begin(), from.outputWeights[o].end(),
+                  p.w2.begin() + static_cast<std::ptrdiff_t>(o * units));
+    p.b2 = from.outputBias;
+}
 }  // namespace
 
 // The features are standardised once; then eight units at a time keep their sums in a register
@@ -148,26 +169,31 @@ void validateHiddenLayer(const HiddenLayerView& layer, std::size_t features,
 
 TrainedLayers trainLayers(std::span<const float> inputs, std::size_t rows, std::size_t features,
                           std::size_t units, std::size_t outputs, int epochs, std::uint32_t seed,
-                          float lossScale, const OutputGradient& gradient) {
+                          float lossScale, const OutputGradient& gradient,
+                          const TrainingStart& start) {
     TrainedLayers net;
-    standardise(inputs, features, net);
-
-    // Hidden weights ~ N(0, 1/features), output weights ~ N(0, 1/units): unit-variance
-    // pre-activations from standardised inputs.
     std::mt19937 rng(seed);
-    std::normal_distribution<float> normal(0.0f, 1.0f);
     Parameters p;
-    p.w1.resize(units * features);
-    p.b1.assign(units, 0.0f);
-    p.w2.resize(outputs * units);
-    p.b2.assign(outputs, 0.0f);
-    for (auto& w : p.w1) w = normal(rng) / std::sqrt(static_cast<float>(features));
-    for (auto& w : p.w2) w = normal(rng) / std::sqrt(static_cast<float>(units));
+    if (start.from) {
+        startFrom(*start.from, features, units, outputs, net, p);
+    } else {
+        standardise(inputs, features, net);
+        // Hidden weights ~ N(0, 1/features), output weights ~ N(0, 1/units): unit-variance
+        // pre-activations from standardised inputs.
+        std::normal_distribution<float> normal(0.0f, 1.0f);
+        p.w1.resize(units * features);
+        p.b1.assign(units, 0.0f);
+        p.w2.resize(outputs * units);
+        p.b2.assign(outputs, 0.0f);
+        for (auto& w : p.w1) w = normal(rng) / std::sqrt(static_cast<float>(features));
+        for (auto& w : p.w2) w = normal(rng) / std::sqrt(static_cast<float>(units));
+    }
     p.g1.resize(p.w1.size());
     p.gb1.resize(units);
     p.g2.resize(p.w2.size());
     p.gb2.resize(outputs);
-    AdamBlock a1(p.w1.size()), ab1(units), a2(p.w2.size()), ab2(outputs);
+    AdamBlock a1(p.w1.size(), start.rate), ab1(units, start.rate), a2(p.w2.size(), start.rate),
+        ab2(outputs, start.rate);
 
     constexpr std::size_t kBatch = 256;
     std::vector<std::size_t> order(rows);

@@ -58,11 +58,20 @@ struct TrainedLayers {
 using OutputGradient =
     std::function<void(std::size_t row, std::span<const float> z, std::span<float> dz)>;
 
-// Trains the layers on `inputs` (rows × features values): the inputs standardised, weights
-// drawn from `seed`, mini-batches of 256 in an order fixed by the seed, Adam on the gradient
-// `gradient` gives per row, times `lossScale` over the batch's rows.
+// Where training starts: from weights drawn from the seed over inputs standardised on their own
+// (`from` null), or from a trained network, its standardisation and weights kept (fine-tuning:
+// `units` and `outputs` must be its sizes). `rate`: Adam's step size.
+struct TrainingStart {
+    const TrainedLayers* from = nullptr;
+    float rate = 1e-3f;
+};
+
+// Trains the layers on `inputs` (rows × features values): mini-batches of 256 in an order fixed
+// by `seed`, Adam on the gradient `gradient` gives per row, times `lossScale` over the batch's
+// rows, from `start`.
 TrainedLayers trainLayers(std::span<const float> inputs, std::size_t rows, std::size_t features,
                           std::size_t units, std::size_t outputs, int epochs, std::uint32_t seed,
-                          float lossScale, const OutputGradient& gradient);
+                          float lossScale, const OutputGradient& gradient,
+                          const TrainingStart& start = {});
 
 }  // namespace lipsyncd::dsp::network

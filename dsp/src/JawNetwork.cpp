@@ -1,5 +1,6 @@
 // The jaw heard from a frame: a one-hidden-layer network over the frame's features (Bourlard &
 // Morgan 1994, a multilayer perceptron on acoustic frames), its evaluation and its training.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <lipsyncd/dsp.hpp>
@@ -37,18 +38,21 @@ void JawNetwork::validate(std::size_t features, const std::string& source) const
                            source);
 }
 
-JawNetwork trainJawNetwork(std::span<const float> inputs, std::span<const float> targets,
-                           std::size_t features, int hiddenUnits, int epochs, std::uint32_t seed) {
+namespace {
+// Squared error through the logistic output: d/dz (y − t)² = 2 (y − t) y (1 − y).
+JawNetwork trainOnHeights(std::span<const float> inputs, std::span<const float> targets,
+                          std::size_t features, std::size_t units, int epochs, std::uint32_t seed,
+                          const network::TrainingStart& start) {
     const std::size_t rows = targets.size();
-    if (features == 0 || rows == 0 || inputs.size() != rows * features || hiddenUnits <= 0)
+    if (features == 0 || rows == 0 || inputs.size() != rows * features || units == 0)
         throw InputError("jaw network: no training frames");
-    // Squared error through the logistic output: d/dz (y − t)² = 2 (y − t) y (1 − y).
     auto layers = network::trainLayers(
-        inputs, rows, features, static_cast<std::size_t>(hiddenUnits), 1, epochs, seed, 2.0f,
+        inputs, rows, features, units, 1, epochs, seed, 2.0f,
         [&](std::size_t row, std::span<const float> z, std::span<float> dz) {
             const float y = logistic(z[0]);
             dz[0] = (y - targets[row]) * y * (1 - y);
-        });
+        },
+        start);
     JawNetwork net;
     net.inputMean = std::move(layers.inputMean);
     net.inputScale = std::move(layers.inputScale);
@@ -57,6 +61,22 @@ JawNetwork trainJawNetwork(std::span<const float> inputs, std::span<const float>
     net.outputWeights = std::move(layers.outputWeights.front());
     net.outputBias = layers.outputBias.front();
     return net;
+}
+}  // namespace
+
+JawNetwork trainJawNetwork(std::span<const float> inputs, std::span<const float> targets,
+                           std::size_t features, int hiddenUnits, int epochs, std::uint32_t seed) {
+    return trainOnHeights(inputs, targets, features,
+                          static_cast<std::size_t>(std::max(0, hiddenUnits)), epochs, seed, {});
+}
+
+JawNetwork fineTuneJawNetwork(const JawNetwork& base, std::span<const float> inputs,
+                              std::span<const float> targets, int epochs, float rate,
+                              std::uint32_t seed) {
+    const network::TrainedLayers start{base.inputMean,  base.inputScale,      base.hiddenWeights,
+                                       base.hiddenBias, {base.outputWeights}, {base.outputBias}};
+    return trainOnHeights(inputs, targets, base.inputMean.size(), base.hiddenUnits(), epochs, seed,
+                          {&start, rate});
 }
 
 }  // namespace lipsyncd::dsp

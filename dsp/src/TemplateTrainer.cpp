@@ -179,6 +179,30 @@ std::optional<ClassNetwork> TemplateTrainer::trainClasses(std::size_t bins) cons
                              options_.classEpochs, options_.seed);
 }
 
+TemplateSet TemplateTrainer::fineTuneNetworks(TemplateSet base, int epochs, float rate) const {
+    const auto features = static_cast<std::size_t>(base.analysis.featureCount());
+    if (classTargets_.empty() || networkInputs_.size() != classTargets_.size() * features)
+        throw InputError("fine-tuning: no frames of speech, or frames of another analysis");
+    if (base.jawNetwork && jawUsable_)
+        base.jawNetwork = fineTuneJawNetwork(*base.jawNetwork, networkInputs_, jawTargets_, epochs,
+                                             rate, options_.seed);
+    if (!base.classNetwork) return base;
+    const auto outputs = base.classNetwork->setIndices(*set_);
+    std::vector<float> inputs;
+    std::vector<std::uint16_t> labels;
+    for (std::size_t row = 0; row < classTargets_.size(); ++row) {
+        const auto it = std::find(outputs.begin(), outputs.end(), int(classTargets_[row]));
+        if (it == outputs.end()) continue;
+        labels.push_back(static_cast<std::uint16_t>(it - outputs.begin()));
+        const auto from = networkInputs_.begin() + static_cast<std::ptrdiff_t>(row * features);
+        inputs.insert(inputs.end(), from, from + static_cast<std::ptrdiff_t>(features));
+    }
+    if (!labels.empty())
+        base.classNetwork =
+            fineTuneClassNetwork(*base.classNetwork, inputs, labels, epochs, rate, options_.seed);
+    return base;
+}
+
 TemplateSet TemplateTrainer::build(const std::string& description) const {
     TemplateSet t;
     t.analysis = options_.analysis;

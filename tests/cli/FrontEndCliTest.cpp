@@ -397,11 +397,22 @@ TEST(LipsyncCli, CalibrateFromReadSpeechMovesTheClassesItHeard) {
     ASSERT_EQ(
         runLipsync({"calibrate", dir.string(), "-o", firm.string(), "--prior", "200"}).exitCode, 0);
     EXPECT_LT(moved(dsp::TemplateSet::load(firm)), 0.5 * moved(own));
-    // Half a minute of one voice trains no network: the base set's stay.
-    ASSERT_TRUE(own.jawNetwork && base.jawNetwork);
-    EXPECT_EQ(own.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
-    ASSERT_TRUE(own.classNetwork && base.classNetwork);
-    EXPECT_EQ(own.classNetwork->outputWeights, base.classNetwork->outputWeights);
+    // The networks are trained further on the voice's aligned frames, from the base's weights
+    // (its input standardisation and class priors kept); with no pass they stay the base's.
+    ASSERT_TRUE(own.jawNetwork && base.jawNetwork && own.classNetwork && base.classNetwork);
+    EXPECT_NE(own.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
+    EXPECT_NE(own.classNetwork->outputWeights, base.classNetwork->outputWeights);
+    EXPECT_EQ(own.classNetwork->inputMean, base.classNetwork->inputMean);
+    EXPECT_EQ(own.classNetwork->logPrior, base.classNetwork->logPrior);
+    EXPECT_NE(r.err.find("networks: 4 pass(es) over"), std::string::npos) << r.err;
+    const auto kept = dir.parent_path() / "calibrated-read-networks-kept.json";
+    ASSERT_EQ(runLipsync({"calibrate", dir.string(), "-o", kept.string(), "--network-epochs", "0"})
+                  .exitCode,
+              0);
+    const auto same = dsp::TemplateSet::load(kept);
+    EXPECT_EQ(same.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
+    EXPECT_EQ(same.classNetwork->outputWeights, base.classNetwork->outputWeights);
+    EXPECT_EQ(same.classNetwork->hiddenWeights, base.classNetwork->hiddenWeights);
 }
 
 // A copy of a WAV file whose header claims `factor` times its sample rate: played slower, its

@@ -25,7 +25,9 @@ struct Utterance {
     PhonemeSchedule labels;
 };
 
-Utterance utterance(std::mt19937& rng, int segments = 40) {
+// `shift` moves bins 0 and 1 apart by that much: another voice, whose frames of one class lie
+// where the first voice's lay for the other.
+Utterance utterance(std::mt19937& rng, int segments = 40, float shift = 0) {
     std::normal_distribution<float> noise(0, 1);
     std::bernoulli_distribution coin;
     Utterance u;
@@ -39,7 +41,7 @@ Utterance utterance(std::mt19937& rng, int segments = 40) {
             f.energyDb = -20;
             f.time = t + 0.005;
             const float a = coin(rng) ? 8.0f : -8.0f, b = aa ? a : -a;
-            f.spectrum = {a + noise(rng), b + noise(rng), noise(rng), noise(rng)};
+            f.spectrum = {a + shift + noise(rng), b - shift + noise(rng), noise(rng), noise(rng)};
             u.frames.push_back(std::move(f));
         }
     }
@@ -70,12 +72,12 @@ TemplateSet train(std::mt19937& rng, int hiddenUnits = 8, int utterances = 4) {
 }
 
 // Share of new frames the classifier decides right.
-double accuracy(const TemplateSet& t, std::mt19937& rng, float classNetworkDb) {
+double accuracy(const TemplateSet& t, std::mt19937& rng, float classNetworkDb, float shift = 0) {
     ClassifierConfig config;
     config.classNetworkDb = classNetworkDb;
     const auto& set = PhonemeSet::common();
     FrameClassifier classifier(t, set, config);
-    const auto u = utterance(rng);
+    const auto u = utterance(rng, 40, shift);
     int right = 0;
     for (const auto& f : u.frames) {
         const auto label = classifier.classify(f);
@@ -106,6 +108,37 @@ TEST(ClassNetwork, TrainingIsReproducibleAndTooLittleSpeechTrainsNone) {
     EXPECT_EQ(first.classNetwork->logPrior, second.classNetwork->logPrior);
     // 800 frames: one voice's quirks, not its classes.
     EXPECT_FALSE(train(c, 8, 1).classNetwork.has_value());
+}
+
+TEST(ClassNetwork, FineTuningOnOneVoiceTeachesTheNetworkThatVoice) {
+    std::mt19937 rng(6);
+    const auto base = train(rng);
+    constexpr float kVoice = 10;
+    const double before = accuracy(base, rng, 1.0f, kVoice);
+    EXPECT_LT(before, 0.75);
+    auto options = fourBins();
+    options.classHiddenUnits = 8;  // the frames the networks learn from are kept
+    TemplateTrainer voice(options, PhonemeSet::common());
+    for (int i = 0; i < 2; ++i) {
+        const auto u = utterance(rng, 40, kVoice);
+        voice.addUtterance(u.frames, u.labels);
+    }
+    EXPECT_EQ(voice.networkFrames(), 1600u);
+    const auto tuned = voice.fineTuneNetworks(base, 20, 3e-3f);
+    ASSERT_TRUE(tuned.classNetwork.has_value());
+    EXPECT_GT(accuracy(tuned, rng, 1.0f, kVoice), 0.9);
+    // From the base's weights, through its standardisation, divided by its priors; the
+    // templates as they were.
+    EXPECT_EQ(tuned.classNetwork->inputMean, base.classNetwork->inputMean);
+    EXPECT_EQ(tuned.classNetwork->logPrior, base.classNetwork->logPrior);
+    EXPECT_NE(tuned.classNetwork->outputWeights, base.classNetwork->outputWeights);
+    ASSERT_EQ(tuned.classes.size(), base.classes.size());
+    for (std::size_t c = 0; c < base.classes.size(); ++c)
+        EXPECT_EQ(tuned.classes[c].spectra, base.classes[c].spectra);
+    // No pass, no change.
+    const auto same = voice.fineTuneNetworks(base, 0, 3e-3f);
+    EXPECT_EQ(same.classNetwork->outputWeights, base.classNetwork->outputWeights);
+    EXPECT_EQ(same.classNetwork->hiddenWeights, base.classNetwork->hiddenWeights);
 }
 
 TEST(ClassNetwork, TheAlignerStillWeighsTheTemplatesAlone) {

@@ -740,6 +740,12 @@ class TemplateTrainer {
     std::size_t frames(const std::string& phoneme) const;
     // Throws InputError when no class has enough frames.
     TemplateSet build(const std::string& description) const;
+    // `base` with its networks trained further on the frames of the utterances added (one
+    // speaker's: calibration), `epochs` passes at Adam's step size `rate`; its templates as they
+    // are. Frames of a class the class network does not know teach only the jaw network. Needs
+    // network frames (TrainingOptions' hidden units above 0) and the base's analysis.
+    TemplateSet fineTuneNetworks(TemplateSet base, int epochs, float rate) const;
+    std::size_t networkFrames() const { return classTargets_.size(); }
 
   private:
     void addFrame(const FrameFeatures& frame, std::size_t phoneme);
@@ -766,6 +772,17 @@ JawNetwork trainJawNetwork(std::span<const float> inputs, std::span<const float>
 ClassNetwork trainClassNetwork(std::span<const float> inputs, std::span<const std::uint16_t> labels,
                                std::span<const std::string> classes, std::size_t features,
                                int hiddenUnits, int epochs, std::uint32_t seed);
+
+// Fine-tuning: `base` trained further on one speaker's frames (labels index `base.classes`;
+// targets as trainJawNetwork's), from its own weights and input standardisation, Adam at step
+// size `rate`. The class network keeps the base's priors: the scaled likelihoods stay divided by
+// the shares of the speech it was first trained on.
+ClassNetwork fineTuneClassNetwork(const ClassNetwork& base, std::span<const float> inputs,
+                                  std::span<const std::uint16_t> labels, int epochs, float rate,
+                                  std::uint32_t seed);
+JawNetwork fineTuneJawNetwork(const JawNetwork& base, std::span<const float> inputs,
+                              std::span<const float> targets, int epochs, float rate,
+                              std::uint32_t seed);
 
 // Frame-by-frame agreement of a schedule with reference labels, sampled every `step` seconds.
 struct ScheduleScore {
