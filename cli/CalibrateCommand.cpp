@@ -11,6 +11,8 @@
 #include <lipsyncd/dsp.hpp>
 #include <lipsyncd/tts.hpp>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "Commands.hpp"
 #include "Corpus.hpp"
@@ -86,6 +88,13 @@ bool isAudio(const std::filesystem::path& file) {
     return ext == ".wav" || ext == ".flac" || ext == ".ogg";
 }
 
+// Every 20th of a long run (20 recordings or more): "aligned 40 of 310 recordings".
+void reportProgress(const char* done, std::size_t i, std::size_t total) {
+    if (total >= 20 && i % 20 == 0 && i > 0)
+        std::cerr << "lipsync calibrate: " << done << ' ' << i << " of " << total
+                  << " recordings\n";
+}
+
 // Read speech: every recording with its words beside it (NAME.txt), aligned on them (on the base
 // set, unwarped). A file with a word the aligner could not place is left out: its schedule there
 // would be the front end's own guess, and calibrating on that teaches the templates their own
@@ -93,24 +102,26 @@ bool isAudio(const std::filesystem::path& file) {
 // `synth` is started only when there are words to read (espeak-ng allows one per process).
 std::vector<ReadRecording> alignReadSpeech(const CalibrateOptions& o, const dsp::TemplateSet& base,
                                            std::optional<EspeakSynthesizer>& synth) {
+    std::vector<std::pair<std::filesystem::path, std::filesystem::path>> files;  // audio, words
+    for (const auto& entry : std::filesystem::directory_iterator(o.folder))
+        if (isAudio(entry.path()))
+            if (const auto words = wordsBeside(entry.path())) files.emplace_back(entry.path(), *words);
+    std::sort(files.begin(), files.end());
     std::vector<ReadRecording> read;
-    for (const auto& entry : std::filesystem::directory_iterator(o.folder)) {
-        if (!isAudio(entry.path())) continue;
-        const auto words = wordsBeside(entry.path());
-        if (!words) continue;
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        const auto& [audio, words] = files[i];
+        reportProgress("aligned", i, files.size());
         if (!synth) synth.emplace();
-        auto text = readTextFile(*words);
-        const auto aligned = alignText(*synth, entry.path(), text, o.voice, base);
+        auto text = readTextFile(words);
+        const auto aligned = alignText(*synth, audio, text, o.voice, base);
         if (aligned.fellBack || !aligned.warnings.empty()) {
-            std::cerr << "lipsync calibrate: skipped " << entry.path().string() << ": "
+            std::cerr << "lipsync calibrate: skipped " << audio.string() << ": "
                       << (aligned.warnings.empty() ? "not aligned" : aligned.warnings.front())
                       << '\n';
             continue;
         }
-        read.push_back({entry.path(), std::move(text), aligned.schedule});
+        read.push_back({audio, std::move(text), aligned.schedule});
     }
-    std::sort(read.begin(), read.end(),
-              [](const auto& a, const auto& b) { return a.audio < b.audio; });
     return read;
 }
 
@@ -177,7 +188,9 @@ double chooseWarp(const std::vector<ReadRecording>& read, const dsp::TemplateSet
 dsp::TemplateSet adaptToReadSpeech(const CalibrateOptions& o, std::vector<ReadRecording>& read,
                                    const dsp::TemplateSet& base, EspeakSynthesizer& synth) {
     dsp::SpeakerAdaptation voice(base);
-    for (auto& r : read) {
+    for (std::size_t i = 0; i < read.size(); ++i) {
+        auto& r = read[i];
+        reportProgress("aligned again, on the voice learnt so far:", i, read.size());
         auto aligned = alignText(synth, r.audio, r.words, o.voice, base, {}, {}, {}, std::nullopt,
                                  true, &voice);
         if (!aligned.fellBack && aligned.warnings.empty()) r.schedule = std::move(aligned.schedule);
