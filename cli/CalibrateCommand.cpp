@@ -105,7 +105,8 @@ std::vector<ReadRecording> alignReadSpeech(const CalibrateOptions& o, const dsp:
     std::vector<std::pair<std::filesystem::path, std::filesystem::path>> files;  // audio, words
     for (const auto& entry : std::filesystem::directory_iterator(o.folder))
         if (isAudio(entry.path()))
-            if (const auto words = wordsBeside(entry.path())) files.emplace_back(entry.path(), *words);
+            if (const auto words = wordsBeside(entry.path()))
+                files.emplace_back(entry.path(), *words);
     std::sort(files.begin(), files.end());
     std::vector<ReadRecording> read;
     for (std::size_t i = 0; i < files.size(); ++i) {
