@@ -21,6 +21,8 @@ struct TrainOptions {
     std::vector<std::string> extraFeatures{"log_error", "level"};
     bool normaliseChannel = false;
     std::string keepTemplates;  // train only the networks, into this set
+    int fineTuneEpochs = 0;     // with keepTemplates: train its networks further (0: anew)
+    float fineTuneRate = 1e-4f;
 };
 
 // The mean spectrum of the training speech (valid frames within 30 dB of their file's peak):
@@ -50,12 +52,22 @@ std::vector<float> speechSpectrumMean(const TrainOptions& o) {
 
 void runTrain(TrainOptions o) {
     std::optional<dsp::TemplateSet> kept;
+    if (o.fineTuneEpochs > 0 && o.keepTemplates.empty())
+        throw InputError(
+            "--fine-tune-epochs trains a set's networks further: give the set with "
+            "--keep-templates");
     if (!o.keepTemplates.empty()) {
         kept = dsp::TemplateSet::named(o.keepTemplates);
         o.training.analysis = kept->analysis;  // the network hears frames as the set does
         o.training.clustersPerClass = 1;       // the clusters are thrown away ...
         o.training.minFramesPerCluster = 1;    // ... and need no minimum
-        if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
+        if (o.fineTuneEpochs > 0) {  // the frames the set's own networks learn from are kept
+            o.training.jawHiddenUnits = kept->jawNetwork ? int(kept->jawNetwork->hiddenUnits()) : 0;
+            o.training.classHiddenUnits =
+                kept->classNetwork ? int(kept->classNetwork->hiddenUnits()) : 0;
+            if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
+                throw InputError("--fine-tune-epochs: " + o.keepTemplates + " has no network");
+        } else if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
             throw InputError(
                 "--keep-templates trains only the networks: --jaw-hidden 0 without "
                 "--class-hidden leaves nothing to train");
@@ -80,6 +92,17 @@ void runTrain(TrainOptions o) {
                 std::cerr << "lipsync train: " << files << " files, " << std::fixed
                           << std::setprecision(0) << seconds << " s of audio\n";
         }
+    }
+    if (kept && o.fineTuneEpochs > 0) {
+        if (trainer.networkFrames() == 0)
+            throw InputError("--fine-tune-epochs: no labelled speech to train on");
+        auto tuned = trainer.fineTuneNetworks(std::move(*kept), o.fineTuneEpochs, o.fineTuneRate);
+        if (!o.description.empty()) tuned.description = o.description;
+        tuned.save(o.output);
+        std::cerr << "lipsync train: " << files << " files (" << std::fixed << std::setprecision(0)
+                  << seconds << " s, " << trainer.networkFrames() << " frames): " << o.keepTemplates
+                  << "'s networks trained further into " << o.output << '\n';
+        return;
     }
     auto templates = trainer.build(o.description.empty() ? "trained by 'lipsync train' from " +
                                                                std::to_string(files) + " files"
@@ -162,6 +185,14 @@ void addTrainCommand(CLI::App& app) {
                     "template set (name or file) with them, its analysis, templates and weights "
                     "unchanged")
         ->excludes("--normalise-channel");
+    addNumberOption(*cmd, "--fine-tune-epochs", o->fineTuneEpochs,
+                    "With --keep-templates: train the set's own networks further on this speech "
+                    "(one speaker's, say) for this many passes, from their weights, instead of "
+                    "new networks (0); the class bias stays",
+                    0, 100);
+    addNumberOption(*cmd, "--fine-tune-rate", o->fineTuneRate,
+                    "Step size of that training (Adam's; networks are trained anew at 0.001)",
+                    1e-6f, 1e-2f);
     cmd->add_option("--description", o->description, "Description stored in the file");
     cmd->callback([o] {
         auto& a = o->training.analysis;

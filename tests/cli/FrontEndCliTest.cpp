@@ -543,5 +543,42 @@ TEST(LipsyncCli, TrainKeepTemplatesReplacesOnlyTheNetworksAskedFor) {
     EXPECT_NE(r.err.find("too little labelled speech"), std::string::npos) << r.err;
 }
 
+// train --keep-templates --fine-tune-epochs: the set's own networks trained further on the speech
+// given (their sizes, standardisation, priors and the class bias kept), not new ones; without a
+// set to start from it is an error.
+TEST(LipsyncCli, TrainFineTuneEpochsTrainsTheSetsOwnNetworksFurther) {
+    const auto dir = scratchDir("cli_train_fine_tune");
+    const char* lines[] = {"Hello puppet, open wide and sing to me.",
+                           "Bob bought a big bag of beans by the bay."};
+    for (int i = 0; i < 2; ++i) {
+        const auto name = dir / ("s" + std::to_string(i));
+        ASSERT_EQ(runLipsync({"say", lines[i], "--voice", "en-us+m3", "--wav",
+                              name.string() + ".wav", "--schedule", name.string() + ".lab"})
+                      .exitCode,
+                  0);
+    }
+    const auto out = dir.parent_path() / "fine-tuned.json";
+    auto r = runLipsync({"train", dir.string(), "--keep-templates", "default", "--fine-tune-epochs",
+                         "2", "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("networks trained further"), std::string::npos) << r.err;
+    const auto tuned = dsp::TemplateSet::load(out);
+    const auto base = dsp::TemplateSet::loadDefault();
+    ASSERT_TRUE(tuned.classNetwork && tuned.jawNetwork && base.classNetwork && base.jawNetwork);
+    EXPECT_EQ(tuned.classNetwork->hiddenUnits(), base.classNetwork->hiddenUnits());
+    EXPECT_EQ(tuned.classNetwork->inputMean, base.classNetwork->inputMean);
+    EXPECT_EQ(tuned.classNetwork->logPrior, base.classNetwork->logPrior);
+    EXPECT_NE(tuned.classNetwork->outputWeights, base.classNetwork->outputWeights);
+    EXPECT_NE(tuned.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
+    EXPECT_EQ(tuned.classBiasDb, base.classBiasDb);
+    ASSERT_EQ(tuned.classes.size(), base.classes.size());
+    for (std::size_t c = 0; c < base.classes.size(); ++c)
+        EXPECT_EQ(tuned.classes[c].spectra, base.classes[c].spectra);
+
+    r = runLipsync({"train", dir.string(), "--fine-tune-epochs", "2", "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("--keep-templates"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace lipsyncd::test
