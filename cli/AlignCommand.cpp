@@ -69,6 +69,8 @@ void runAlign(const AlignOptions& o) {
     std::optional<dsp::SpeakerAdaptation> speaker;
     if (!o.speaker.empty()) {
         speaker.emplace(templates);
+        speaker->learnNetworks(o.aligner.config.speakerNetworkEpochs,
+                               o.aligner.config.speakerNetworkRate);
         if (std::filesystem::exists(o.speaker)) speaker->load(o.speaker);
     }
     EspeakSynthesizer synth;
@@ -122,6 +124,10 @@ void addAlignCommand(CLI::App& app) {
     cmd->add_option("--speaker", o->speaker,
                     "A speaker file: align on the voice the earlier lines taught it, and add this "
                     "line's (created when missing; lipsyncd's speaker_file has the same format)");
+    addNumberOption(*cmd, "--speaker-network-epochs", o->aligner.config.speakerNetworkEpochs,
+                    "With --speaker: the line also trains the speaker's class and jaw networks "
+                    "further on its placed frames, this many passes (0: they stay as they are)",
+                    0, 100);
     cmd->add_flag("--quiet,-q", o->quiet, "No summary on stderr");
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, true);

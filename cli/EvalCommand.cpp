@@ -134,7 +134,13 @@ struct Evaluator {
     // words beside the file (--align), else analysed from the audio alone.
     std::pair<PhonemeSchedule, LevelTrack> schedule(const CorpusItem& item) const {
         dsp::SpeakerAdaptation* speaker = nullptr;
-        if (o.adaptSpeaker) speaker = &speakers.try_emplace(item.speaker, templates).first->second;
+        if (o.adaptSpeaker) {
+            auto [it, fresh] = speakers.try_emplace(item.speaker, templates);
+            if (fresh)
+                it->second.learnNetworks(o.aligner.config.speakerNetworkEpochs,
+                                         o.aligner.config.speakerNetworkRate);
+            speaker = &it->second;
+        }
         if (!o.align) return analyse(item, speaker, true);
         if (auto r = align(item, speaker)) return {std::move(r->schedule), std::move(r->levels)};
         return analyse(item, speaker, false);
@@ -506,6 +512,11 @@ void addEvalCommand(CLI::App& app) {
                   "speaker's earlier files (aligned on their words, NAME.txt). Without --align "
                   "each file is analysed from the audio on that voice, then its words teach it: "
                   "the service's adapt_speaker for files played without words");
+    addNumberOption(*cmd, "--speaker-network-epochs", o->aligner.config.speakerNetworkEpochs,
+                    "With --adapt-speaker: each file also trains the speaker's class and jaw "
+                    "networks further on its placed frames, this many passes (0: the set's "
+                    "networks stay)",
+                    0, 100);
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, false);
     cmd->callback([o] { runEval(*o); });

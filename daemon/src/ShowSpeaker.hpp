@@ -1,5 +1,6 @@
 // The show's voice so far. Every played file with its words teaches it (the frames the
-// alignment placed: dsp::SpeakerAdaptation), and what it has learnt serves what comes next: the
+// alignment placed: dsp::SpeakerAdaptation, the templates moved toward them and the networks
+// trained further on them), and what it has learnt serves what comes next: the
 // next line with words starts from it, a file without words is recognised on it, and live input
 // started afterwards follows it. The worker aligns a line on a copy (alignment takes seconds;
 // the loop must not wait for it) and what the copy learnt replaces the shared voice, unless a

@@ -77,6 +77,31 @@ void SpeakerAdaptation::add(std::span<const FrameFeatures> frames, const Phoneme
             ++frames_;
         }
     }
+    trainNetworks(frames, segments);
+}
+
+void SpeakerAdaptation::learnNetworks(int epochs, float rate) {
+    networkEpochs_ = std::max(0, epochs);
+    networkRate_ = rate;
+}
+
+void SpeakerAdaptation::trainNetworks(std::span<const FrameFeatures> frames,
+                                      const PhonemeSchedule& segments) {
+    if (networkEpochs_ == 0 || (!base_.jawNetwork && !base_.classNetwork)) return;
+    TrainingOptions training;
+    training.analysis = base_.analysis;
+    training.jawHiddenUnits = base_.jawNetwork ? int(base_.jawNetwork->hiddenUnits()) : 0;
+    training.classHiddenUnits = base_.classNetwork ? int(base_.classNetwork->hiddenUnits()) : 0;
+    TemplateTrainer trainer(training, PhonemeSet::common());
+    trainer.addUtterance(frames, segments);
+    if (trainer.networkFrames() == 0) return;
+    TemplateSet current;
+    current.analysis = base_.analysis;
+    current.jawNetwork = jawNetwork_ ? jawNetwork_ : base_.jawNetwork;
+    current.classNetwork = classNetwork_ ? classNetwork_ : base_.classNetwork;
+    auto tuned = trainer.fineTuneNetworks(std::move(current), networkEpochs_, networkRate_);
+    jawNetwork_ = std::move(tuned.jawNetwork);
+    classNetwork_ = std::move(tuned.classNetwork);
 }
 
 void SpeakerAdaptation::add(const SpeakerAdaptation& other) {
@@ -84,6 +109,11 @@ void SpeakerAdaptation::add(const SpeakerAdaptation& other) {
     for (std::size_t i = 0; i < sums_.size(); ++i) sums_[i] += other.sums_[i];
     for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] += other.counts_[i];
     frames_ += other.frames_;
+    // Networks cannot be summed: a set that has trained none takes the other's.
+    if (!classNetwork_ && !jawNetwork_) {
+        classNetwork_ = other.classNetwork_;
+        jawNetwork_ = other.jawNetwork_;
+    }
 }
 
 TemplateSet SpeakerAdaptation::adapted(float priorFrames) const {
@@ -100,6 +130,8 @@ TemplateSet SpeakerAdaptation::adapted(float priorFrames) const {
                                                      (tau + n));
             ++t;
         }
+    if (classNetwork_) out.classNetwork = classNetwork_;
+    if (jawNetwork_) out.jawNetwork = jawNetwork_;
     return out;
 }
 

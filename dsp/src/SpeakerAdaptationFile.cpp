@@ -1,7 +1,9 @@
 // A speaker's learnt frames in a file: {"format": "lipsyncd-speaker", "version": 1, "base":
-// FINGERPRINT, "heard": [{"template": INDEX, "frames": N, "sum": [one number a feature]}, ...]}.
-// Only the templates heard are written; the fingerprint ties the sums to the base set they were
-// assigned against (another set's template indices mean other sounds).
+// FINGERPRINT, "heard": [{"template": INDEX, "frames": N, "sum": [one number a feature]}, ...]},
+// and the networks trained further on them when there are any ("class_network", "jaw_network",
+// as in a template file; files written before they existed have none). Only the templates heard
+// are written; the fingerprint ties the sums to the base set they were assigned against (another
+// set's template indices mean other sounds).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -11,6 +13,7 @@
 #include <sstream>
 
 #include "JsonField.hpp"
+#include "NetworkJson.hpp"
 #include "TemplateMatrix.hpp"
 
 namespace lipsyncd::dsp {
@@ -35,6 +38,33 @@ std::string fingerprint(const TemplateSet& base) {
     s << std::hex << std::setw(16) << std::setfill('0') << h;
     return s.str();
 }
+
+// The networks a speaker file carries, each valid and of the base's own network's shape (its
+// weights trained further: another set's networks, or none, are another base).
+std::pair<std::optional<ClassNetwork>, std::optional<JawNetwork>> readNetworks(
+    const nlohmann::json& j, const TemplateSet& base, const std::string& source) {
+    const auto features = static_cast<std::size_t>(base.analysis.featureCount());
+    std::optional<ClassNetwork> classNetwork;
+    std::optional<JawNetwork> jawNetwork;
+    if (j.contains("class_network")) {
+        classNetwork = readClassNetwork(j["class_network"], source);
+        classNetwork->validate(features, source);
+        if (!base.classNetwork || base.classNetwork->classes != classNetwork->classes ||
+            base.classNetwork->hiddenUnits() != classNetwork->hiddenUnits())
+            throw InputError(source, 0,
+                             "field 'class_network': not the base set's class network trained "
+                             "further; start again with `speaker reset`");
+    }
+    if (j.contains("jaw_network")) {
+        jawNetwork = readJawNetwork(j["jaw_network"], source);
+        jawNetwork->validate(features, source);
+        if (!base.jawNetwork || base.jawNetwork->hiddenUnits() != jawNetwork->hiddenUnits())
+            throw InputError(source, 0,
+                             "field 'jaw_network': not the base set's jaw network trained "
+                             "further; start again with `speaker reset`");
+    }
+    return {std::move(classNetwork), std::move(jawNetwork)};
+}
 }  // namespace
 
 void SpeakerAdaptation::save(const std::filesystem::path& file) const {
@@ -47,8 +77,10 @@ void SpeakerAdaptation::save(const std::filesystem::path& file) const {
                          {"frames", counts_[t]},
                          {"sum", std::vector<double>(sum, sum + features)}});
     }
-    const nlohmann::json j = {
+    nlohmann::json j = {
         {"format", kFormat}, {"version", kVersion}, {"base", fingerprint(base_)}, {"heard", heard}};
+    if (classNetwork_) j["class_network"] = writeClassNetwork(*classNetwork_);
+    if (jawNetwork_) j["jaw_network"] = writeJawNetwork(*jawNetwork_);
     auto temporary = file;
     temporary += ".tmp";
     {
@@ -96,9 +128,12 @@ void SpeakerAdaptation::load(const std::filesystem::path& file) {
         counts[t] = n;
         frames += n;
     }
+    auto [classNetwork, jawNetwork] = readNetworks(j, base_, source);
     sums_ = std::move(sums);
     counts_ = std::move(counts);
     frames_ = static_cast<std::size_t>(std::llround(frames));
+    classNetwork_ = std::move(classNetwork);
+    jawNetwork_ = std::move(jawNetwork);
 }
 
 }  // namespace lipsyncd::dsp

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <fstream>
+
 #include "DaemonProcess.hpp"
 
 namespace lipsyncd::test {
@@ -243,6 +245,11 @@ TEST(ClipPreparation, TheShowsVoiceOutlivesARestartInItsFile) {
         ASSERT_GT(taught["frames"].get<int>(), 100) << taught;
         EXPECT_TRUE(std::filesystem::exists(voice));
         EXPECT_EQ(d.stop(), 0);
+    }
+    {  // the networks the line trained further are kept too
+        std::ifstream in(voice);
+        const auto file = json::parse(in);
+        EXPECT_TRUE(file.contains("class_network") && file.contains("jaw_network"));
     }
     {
         DaemonProcess d(key);

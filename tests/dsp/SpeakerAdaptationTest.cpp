@@ -125,5 +125,91 @@ TEST(SpeakerAdaptation, WhatWasLearntIsKeptInAFileAcrossRuns) {
     std::filesystem::remove(file);
 }
 
+// Four features (the fewest an analysis has), "ah" and "d" one template each, and small
+// networks over them: two hidden units, each seeing one of the first two features; the class
+// network over "ah" and "d" calls the first feature high "ah", the second "d".
+TemplateSet withNetworks() {
+    TemplateSet t;
+    t.analysis.spectrumBins = 4;
+    t.binWeights = {1, 1, 1, 1};
+    t.classes = {{"ah", {{10, 0, 0, 0}}, 100}, {"d", {{0, 10, 0, 0}}, 100}};
+    ClassNetwork c;
+    c.classes = {"ah", "d"};
+    c.inputMean = {0, 0, 0, 0};
+    c.inputScale = {0.1f, 0.1f, 1, 1};
+    c.hiddenWeights = {{1, 0}, {0, 1}, {0, 0}, {0, 0}};
+    c.hiddenBias = {0, 0};
+    c.outputWeights = {{0.5f, -0.5f}, {-0.5f, 0.5f}};
+    c.outputBias = {0, 0};
+    c.logPrior = {-0.7f, -0.7f};
+    t.classNetwork = c;
+    JawNetwork j;
+    j.inputMean = c.inputMean;
+    j.inputScale = c.inputScale;
+    j.hiddenWeights = c.hiddenWeights;
+    j.hiddenBias = {0, 0};
+    j.outputWeights = {0.2f, -0.2f};
+    t.jawNetwork = j;
+    return t;
+}
+
+// Frames every 10 ms from 0.005 s, each at (a, b, 0, 0).
+std::vector<FrameFeatures> fourFeatureFrames(int count, float a, float b) {
+    auto out = frames(count, a, b);
+    for (auto& f : out) f.spectrum.insert(f.spectrum.end(), {0.0f, 0.0f});
+    return out;
+}
+
+// ln p(ah | x) − ln p(d | x) from the class network of `t`.
+float ahOverD(const TemplateSet& t, float a, float b) {
+    std::vector<float> out(2), scratch(2);
+    t.classNetwork->scaledLogLikelihoods(std::vector<float>{a, b, 0, 0}, out, scratch, 0.0f);
+    return out[0] - out[1];
+}
+
+// A show's voice trains the networks further line by line (learnNetworks); adapted() carries
+// them, the speaker file keeps them, and a file whose networks are not the base's is refused.
+TEST(SpeakerAdaptation, LearningNetworksTrainsThemFurtherOnEachLineAndKeepsThemInTheFile) {
+    const auto base = withNetworks();
+    // "ah" heard where the base network leans to "d" (the second feature high).
+    const auto line = fourFeatureFrames(60, 2, 12);
+    const PhonemeSchedule labels = {{0.0, 0.6, "ah"}};
+    SpeakerAdaptation templatesOnly(base);
+    templatesOnly.add(line, labels);
+    EXPECT_EQ(templatesOnly.adapted(3).classNetwork->outputWeights,
+              base.classNetwork->outputWeights);
+
+    SpeakerAdaptation voice(base);
+    voice.learnNetworks(4, 0.01f);
+    voice.add(line, labels);
+    const auto once = voice.adapted(3);
+    ASSERT_TRUE(once.classNetwork && once.jawNetwork);
+    EXPECT_GT(ahOverD(once, 2, 12), ahOverD(base, 2, 12));
+    EXPECT_NE(once.jawNetwork->outputWeights, base.jawNetwork->outputWeights);
+    EXPECT_EQ(once.classNetwork->logPrior, base.classNetwork->logPrior);
+    voice.add(line, labels);  // the next line goes on from there
+    EXPECT_GT(ahOverD(voice.adapted(3), 2, 12), ahOverD(once, 2, 12));
+
+    const auto file = std::filesystem::temp_directory_path() / "lipsyncd_speaker_networks.json";
+    voice.save(file);
+    SpeakerAdaptation restarted(base);
+    restarted.load(file);
+    EXPECT_NEAR(ahOverD(restarted.adapted(3), 2, 12), ahOverD(voice.adapted(3), 2, 12), 1e-3);
+    // The same templates, but a class network of another shape: not this base's.
+    auto other = base;
+    other.classNetwork->hiddenWeights = {{1, 0, 0}, {0, 1, 0}, {0, 0, 0}, {0, 0, 0}};
+    other.classNetwork->hiddenBias = {0, 0, 0};
+    other.classNetwork->outputWeights.push_back({0, 0});
+    SpeakerAdaptation elsewhere(other);
+    try {
+        elsewhere.load(file);
+        ADD_FAILURE() << "loaded networks trained from another set's";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("class_network"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(elsewhere.frames(), 0u);
+    std::filesystem::remove(file);
+}
+
 }  // namespace
 }  // namespace lipsyncd::dsp

@@ -942,6 +942,14 @@ struct AlignerConfig {
     // of the templates the next line starts from. Chosen on the same speakers, each line
     // adapting the next (10 / 30 / 100 frames: 87.9 / 89.4 / 89.3 % and 59.3 / 59.2 / 59.3 %).
     float speakerAdaptationPriorFrames = 30.0f;
+    // That carried voice also trains the set's networks further on each line's placed frames
+    // (SpeakerAdaptation::learnNetworks): passes over the line, at Adam's step size (0 passes:
+    // the base's networks stay). As `lipsync calibrate` trains them on its read speech. Chosen on
+    // the six tune voices, each carried over its files (`lipsync eval --adapt-speaker`, summed;
+    // score = visual groups + 50 jaw r + 0.5 (closures caught - false)): from the audio alone
+    // 642.0 with none, 642.3 with 1 pass, 644.7 with 4; aligned 751.5, 754.9, 756.4.
+    int speakerNetworkEpochs = 4;
+    float speakerNetworkRate = 1e-4f;
     // How much of what the class network and the set's class bias add to the templates'
     // distances (FrameClassifier::distances() over templateDistances()) the aligner weighs too,
     // 0..1 (0: the templates alone). The network has heard far more people than the templates
@@ -981,7 +989,8 @@ struct Alignment {
 // and each template heard becomes (τ·t + Σx) / (τ + n) over its n frames: the maximum a
 // posteriori estimate of a mean under a prior worth τ frames (Gauvain & Lee 1994). Frames at a
 // segment's edges are left out: they straddle two sounds. Frames are assigned against the base
-// set, so what is added does not depend on what was added before.
+// set, so what is added does not depend on what was added before. With learnNetworks, each
+// utterance also trains the set's class and jaw networks further (those do depend on the order).
 class SpeakerAdaptation {
   public:
     explicit SpeakerAdaptation(TemplateSet base);
@@ -991,6 +1000,10 @@ class SpeakerAdaptation {
     void add(std::span<const FrameFeatures> frames, const PhonemeSchedule& segments,
              std::span<const std::uint8_t> silent = {});
     void add(const SpeakerAdaptation& other);  // another's frames (the same base set)
+    // From now on each utterance added also trains the set's networks further on its frames
+    // (TemplateTrainer::fineTuneNetworks: `epochs` passes at Adam step `rate`), from where the
+    // utterances before left them; adapted() carries them. 0 passes: the base's networks stay.
+    void learnNetworks(int epochs, float rate);
     // The base set with every template heard moved, under a prior worth `priorFrames` frames.
     TemplateSet adapted(float priorFrames) const;
     // adapted() once any frame has been learnt; before that nothing (the base serves as it is).
@@ -998,19 +1011,24 @@ class SpeakerAdaptation {
     std::size_t frames() const { return frames_; }  // frames learnt so far
     const TemplateSet& base() const { return base_; }
     // What has been learnt, kept in a file across runs (lipsyncd's speaker_file): the templates
-    // heard, with a fingerprint of the base set. save() writes FILE.tmp and renames it over FILE,
-    // so a crash leaves the last good file. load() replaces what has been learnt; InputError
-    // naming the file and field when it is not such a file or was learnt on another base set
-    // (what had been learnt stays).
+    // heard and the networks trained further, with a fingerprint of the base set. save() writes
+    // FILE.tmp and renames it over FILE, so a crash leaves the last good file. load() replaces what
+    // has been learnt; InputError naming the file and field when it is not such a file or was
+    // learnt on another base set (what had been learnt stays).
     void save(const std::filesystem::path& file) const;
     void load(const std::filesystem::path& file);
 
   private:
     std::size_t nearestOfClass(std::span<const float> x, std::size_t cls,
                                std::vector<double>& distances) const;
+    void trainNetworks(std::span<const FrameFeatures> frames, const PhonemeSchedule& segments);
 
     TemplateSet base_;
     std::shared_ptr<const FeatureWeighting> weighting_;  // the classifier's distance
+    int networkEpochs_ = 0;
+    float networkRate_ = 1e-4f;
+    std::optional<ClassNetwork> classNetwork_;  // trained further on the utterances (learnNetworks)
+    std::optional<JawNetwork> jawNetwork_;
     // The base, weighted: per class, [feature][template of the class], so that one feature
     // serves every template of the class at once.
     std::vector<float> weighted_;
