@@ -509,7 +509,8 @@ void addEvalCommand(CLI::App& app) {
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "
                   "lines: each file starts from templates moved toward the frames placed in that "
-                  "speaker's earlier files (aligned on their words, NAME.txt). Without --align "
+                  "speaker's earlier files (aligned on their words, NAME.txt) and networks trained "
+                  "further on them. Without --align "
                   "each file is analysed from the audio on that voice, then its words teach it: "
                   "the service's adapt_speaker for files played without words");
     addNumberOption(*cmd, "--speaker-network-epochs", o->aligner.config.speakerNetworkEpochs,
