@@ -206,12 +206,8 @@ dsp::TemplateSet adaptToReadSpeech(const CalibrateOptions& o, std::vector<ReadRe
 dsp::TemplateSet fineTuneOnReadSpeech(const CalibrateOptions& o,
                                       const std::vector<ReadRecording>& read,
                                       const dsp::TemplateSet& set) {
-    dsp::TrainingOptions training;
-    training.analysis = set.analysis;
-    training.jawHiddenUnits = set.jawNetwork ? int(set.jawNetwork->hiddenUnits()) : 0;
-    training.classHiddenUnits = set.classNetwork ? int(set.classNetwork->hiddenUnits()) : 0;
-    if (training.jawHiddenUnits == 0 && training.classHiddenUnits == 0) return set;
-    dsp::TemplateTrainer trainer(training, PhonemeSet::common());
+    if (!set.jawNetwork && !set.classNetwork) return set;
+    dsp::TemplateTrainer trainer(dsp::fineTuningOptions(set), PhonemeSet::common());
     for (const auto& r : read) {
         std::vector<std::string> warnings;
         trainer.addUtterance(dsp::analyzeFrames(r.audio, set.analysis, {}, &warnings), r.schedule);

@@ -62,11 +62,9 @@ void runTrain(TrainOptions o) {
         o.training.clustersPerClass = 1;       // the clusters are thrown away ...
         o.training.minFramesPerCluster = 1;    // ... and need no minimum
         if (o.fineTuneEpochs > 0) {  // the frames the set's own networks learn from are kept
-            o.training.jawHiddenUnits = kept->jawNetwork ? int(kept->jawNetwork->hiddenUnits()) : 0;
-            o.training.classHiddenUnits =
-                kept->classNetwork ? int(kept->classNetwork->hiddenUnits()) : 0;
-            if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
+            if (!kept->jawNetwork && !kept->classNetwork)
                 throw InputError("--fine-tune-epochs: " + o.keepTemplates + " has no network");
+            o.training = dsp::fineTuningOptions(*kept);
         } else if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
             throw InputError(
                 "--keep-templates trains only the networks: --jaw-hidden 0 without "

@@ -88,11 +88,7 @@ void SpeakerAdaptation::learnNetworks(int epochs, float rate) {
 void SpeakerAdaptation::trainNetworks(std::span<const FrameFeatures> frames,
                                       const PhonemeSchedule& segments) {
     if (networkEpochs_ == 0 || (!base_.jawNetwork && !base_.classNetwork)) return;
-    TrainingOptions training;
-    training.analysis = base_.analysis;
-    training.jawHiddenUnits = base_.jawNetwork ? int(base_.jawNetwork->hiddenUnits()) : 0;
-    training.classHiddenUnits = base_.classNetwork ? int(base_.classNetwork->hiddenUnits()) : 0;
-    TemplateTrainer trainer(training, PhonemeSet::common());
+    TemplateTrainer trainer(fineTuningOptions(base_), PhonemeSet::common());
     trainer.addUtterance(frames, segments);
     if (trainer.networkFrames() == 0) return;
     TemplateSet current;

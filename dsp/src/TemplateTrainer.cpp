@@ -179,6 +179,14 @@ std::optional<ClassNetwork> TemplateTrainer::trainClasses(std::size_t bins) cons
                              options_.classEpochs, options_.seed);
 }
 
+TrainingOptions fineTuningOptions(const TemplateSet& set) {
+    TrainingOptions training;
+    training.analysis = set.analysis;
+    training.jawHiddenUnits = set.jawNetwork ? int(set.jawNetwork->hiddenUnits()) : 0;
+    training.classHiddenUnits = set.classNetwork ? int(set.classNetwork->hiddenUnits()) : 0;
+    return training;
+}
+
 TemplateSet TemplateTrainer::fineTuneNetworks(TemplateSet base, int epochs, float rate) const {
     const auto features = static_cast<std::size_t>(base.analysis.featureCount());
     if (classTargets_.empty() || networkInputs_.size() != classTargets_.size() * features)

@@ -727,6 +727,11 @@ struct TrainingOptions {
     int classEpochs = 4;
 };
 
+// Options for a TemplateTrainer that keeps the frames `set`'s own networks learn from (its
+// analysis, its networks' hidden units), for TemplateTrainer::fineTuneNetworks; no network in
+// the set: none kept (networkFrames() stays 0).
+TrainingOptions fineTuningOptions(const TemplateSet& set);
+
 // Builds templates as cluster means of labelled frames (k-means per class on LPC spectra, the
 // viseme clusters of paper 001 section 4 applied to spectra) and distance weights from the pooled
 // within-class variance per bin, or its whole covariance (TrainingOptions::fullCovariance).
