@@ -94,7 +94,10 @@ json Daemon::Impl::speakerReply() const {
     const auto* voice = setup->clips->speaker();
     if (!voice) return {{"adapting", false}};
     const auto heard = voice->heard();
-    return {{"adapting", true}, {"lines", heard.lines}, {"frames", heard.frames}};
+    return {{"adapting", true},
+            {"lines", heard.lines},
+            {"frames", heard.frames},
+            {"networks_trained", heard.networks}};
 }
 
 json Daemon::Impl::speaker(const std::string& action) {

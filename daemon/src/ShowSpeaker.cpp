@@ -84,7 +84,7 @@ void ShowSpeaker::reset() {
 
 ShowSpeaker::Heard ShowSpeaker::heard() const {
     const std::lock_guard lock(mutex_);
-    return {lines_, voice_.frames()};
+    return {lines_, voice_.frames(), voice_.networksTrained()};
 }
 
 }  // namespace lipsyncd::daemon

@@ -205,7 +205,8 @@ TEST(ClipPreparation, LinesPlayedWithTheirWordsTeachTheShowsVoice) {
     d.start();
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
-    EXPECT_EQ(speakerOf(c), (json{{"adapting", true}, {"lines", 0}, {"frames", 0}}));
+    EXPECT_EQ(speakerOf(c),
+              (json{{"adapting", true}, {"lines", 0}, {"frames", 0}, {"networks_trained", false}}));
     const auto wav = d.dir / "line.wav";
     std::filesystem::copy_file(findDataFile("examples/hello.wav"), wav);
     prepare(c, {{"cmd", "play"}, {"file", wav.string()}});  // no words
@@ -214,6 +215,7 @@ TEST(ClipPreparation, LinesPlayedWithTheirWordsTeachTheShowsVoice) {
     const auto taught = speakerOf(c);
     EXPECT_EQ(taught["lines"], 1) << taught;
     EXPECT_GT(taught["frames"].get<int>(), 100) << taught;
+    EXPECT_EQ(taught["networks_trained"], true) << taught;
     EXPECT_NE(d.log().find("the show's voice learnt from 1 line(s)"), std::string::npos) << d.log();
     ::kill(d.pid, SIGHUP);
     ASSERT_TRUE(notify.waitFor("RELOADING=1"));
@@ -222,6 +224,7 @@ TEST(ClipPreparation, LinesPlayedWithTheirWordsTeachTheShowsVoice) {
     const auto reset = c.request({{"cmd", "speaker"}, {"action", "reset"}});
     ASSERT_TRUE(reset["ok"]) << reset;
     EXPECT_EQ(reset["speaker"]["frames"], 0) << reset;
+    EXPECT_EQ(reset["speaker"]["networks_trained"], false) << reset;
     const auto bad = c.request({{"cmd", "speaker"}, {"action", "forget"}});
     EXPECT_EQ(bad["ok"], false);
     EXPECT_NE(errorOf(bad).find("show or reset"), std::string::npos) << bad;

@@ -1014,6 +1014,7 @@ class SpeakerAdaptation {
     // adapted() once any frame has been learnt; before that nothing (the base serves as it is).
     std::optional<TemplateSet> adaptedIfHeard(float priorFrames) const;
     std::size_t frames() const { return frames_; }  // frames learnt so far
+    bool networksTrained() const { return classNetwork_ || jawNetwork_; }  // learnNetworks did
     const TemplateSet& base() const { return base_; }
     // What has been learnt, kept in a file across runs (lipsyncd's speaker_file): the templates
     // heard and the networks trained further, with a fingerprint of the base set. save() writes
