@@ -58,17 +58,19 @@ void runTrain(TrainOptions o) {
             "--keep-templates");
     if (!o.keepTemplates.empty()) {
         kept = dsp::TemplateSet::named(o.keepTemplates);
-        o.training.analysis = kept->analysis;  // the network hears frames as the set does
-        o.training.clustersPerClass = 1;       // the clusters are thrown away ...
-        o.training.minFramesPerCluster = 1;    // ... and need no minimum
         if (o.fineTuneEpochs > 0) {  // the frames the set's own networks learn from are kept
             if (!kept->jawNetwork && !kept->classNetwork)
                 throw InputError("--fine-tune-epochs: " + o.keepTemplates + " has no network");
             o.training = dsp::fineTuningOptions(*kept);
-        } else if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
-            throw InputError(
-                "--keep-templates trains only the networks: --jaw-hidden 0 without "
-                "--class-hidden leaves nothing to train");
+        } else {
+            o.training.analysis = kept->analysis;  // the network hears frames as the set does
+            o.training.clustersPerClass = 1;       // the clusters are thrown away ...
+            o.training.minFramesPerCluster = 1;    // ... and need no minimum
+            if (o.training.jawHiddenUnits == 0 && o.training.classHiddenUnits == 0)
+                throw InputError(
+                    "--keep-templates trains only the networks: --jaw-hidden 0 without "
+                    "--class-hidden leaves nothing to train");
+        }
     }
     if (o.normaliseChannel) o.training.analysis.spectrumMean = speechSpectrumMean(o);
     const auto& set = PhonemeSet::common();

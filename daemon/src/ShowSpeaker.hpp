@@ -43,8 +43,8 @@ class ShowSpeaker {
     struct Heard {
         std::size_t lines = 0;   // lines that taught it something (since start or reset)
         std::size_t frames = 0;  // frames learnt
-        bool networks =
-            false;  // its networks trained further (AlignerConfig::speakerNetworkEpochs)
+        // Its networks trained further (AlignerConfig::speakerNetworkEpochs).
+        bool networks = false;
     };
     Heard heard() const;
     const std::filesystem::path& file() const { return file_; }

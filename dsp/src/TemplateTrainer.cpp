@@ -195,13 +195,17 @@ TemplateSet TemplateTrainer::fineTuneNetworks(TemplateSet base, int epochs, floa
         base.jawNetwork = fineTuneJawNetwork(*base.jawNetwork, networkInputs_, jawTargets_, epochs,
                                              rate, options_.seed);
     if (!base.classNetwork) return base;
-    const auto outputs = base.classNetwork->setIndices(*set_);
+    // Per class of the set, its output in the network (-1: none).
+    std::vector<int> outputOf(set_->size(), -1);
+    const auto indices = base.classNetwork->setIndices(*set_);
+    for (std::size_t o = 0; o < indices.size(); ++o)
+        if (indices[o] >= 0) outputOf[static_cast<std::size_t>(indices[o])] = int(o);
     std::vector<float> inputs;
     std::vector<std::uint16_t> labels;
     for (std::size_t row = 0; row < classTargets_.size(); ++row) {
-        const auto it = std::find(outputs.begin(), outputs.end(), int(classTargets_[row]));
-        if (it == outputs.end()) continue;
-        labels.push_back(static_cast<std::uint16_t>(it - outputs.begin()));
+        const int output = outputOf[classTargets_[row]];
+        if (output < 0) continue;
+        labels.push_back(static_cast<std::uint16_t>(output));
         const auto from = networkInputs_.begin() + static_cast<std::ptrdiff_t>(row * features);
         inputs.insert(inputs.end(), from, from + static_cast<std::ptrdiff_t>(features));
     }
