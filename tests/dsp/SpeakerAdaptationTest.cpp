@@ -33,6 +33,18 @@ std::vector<FrameFeatures> frames(int count, float a, float b) {
     return out;
 }
 
+// `voice` refuses to load `file`, saying the file and `named` (the field at fault).
+void expectRefused(SpeakerAdaptation& voice, const std::filesystem::path& file,
+                   const std::string& named) {
+    try {
+        voice.load(file);
+        ADD_FAILURE() << "loaded " << file << " despite its " << named;
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+}
+
 TEST(SpeakerAdaptation, EachTemplateMovesTowardItsNearestFramesByTheirShareOfThePrior) {
     SpeakerAdaptation adaptation(twoClasses());
     // Six frames of "ah" near its second template; the first and last are edge frames.
@@ -99,12 +111,7 @@ TEST(SpeakerAdaptation, WhatWasLearntIsKeptInAFileAcrossRuns) {
     auto other = twoClasses();
     other.classes[1].spectra[0] = {-6, 5};
     SpeakerAdaptation elsewhere(other);
-    try {
-        elsewhere.load(file);
-        ADD_FAILURE() << "loaded a voice learnt on other templates";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("'base'"), std::string::npos) << e.what();
-    }
+    expectRefused(elsewhere, file, "'base'");  // a voice learnt on other templates
     EXPECT_EQ(elsewhere.frames(), 0u);
 
     std::string text;
@@ -114,13 +121,7 @@ TEST(SpeakerAdaptation, WhatWasLearntIsKeptInAFileAcrossRuns) {
     }
     text.replace(text.find("\"sum\":["), 7, "\"sum\":[1,");  // one number too many
     std::ofstream(file) << text;
-    try {
-        restarted.load(file);
-        ADD_FAILURE() << "loaded a broken file";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("heard[0].sum"), std::string::npos) << e.what();
-    }
+    expectRefused(restarted, file, "heard[0].sum");
     EXPECT_EQ(restarted.frames(), learnt.frames());  // what it had stays
     std::filesystem::remove(file);
 }
@@ -201,12 +202,7 @@ TEST(SpeakerAdaptation, LearningNetworksTrainsThemFurtherOnEachLineAndKeepsThemI
     other.classNetwork->hiddenBias = {0, 0, 0};
     other.classNetwork->outputWeights.push_back({0, 0});
     SpeakerAdaptation elsewhere(other);
-    try {
-        elsewhere.load(file);
-        ADD_FAILURE() << "loaded networks trained from another set's";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("class_network"), std::string::npos) << e.what();
-    }
+    expectRefused(elsewhere, file, "class_network");  // networks trained from another set's
     EXPECT_EQ(elsewhere.frames(), 0u);
     std::filesystem::remove(file);
 }
