@@ -142,6 +142,8 @@ if [ "$mode" = --channel-normalised ]; then
   channel=(--normalise-channel --mean-prior 2)
 fi
 out="${out:-$shipped}"
+# --networks-only keeps the shipped set's templates: a new -o file starts as a copy of it.
+[ "$mode" != --networks-only ] || [ -e "$out" ] || cp "$shipped" "$out"
 if [ "$mode" != --networks-only ]; then
   "$lipsync" train "${folders[@]}" "${template_folders[@]+"${template_folders[@]}"}" --clusters 24 "${channel[@]}" --jaw-hidden 0 --class-hidden 0 \
     -o "$out" --description "$kind: trained by scripts/train-templates.sh on $about ($detail)"
