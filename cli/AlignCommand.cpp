@@ -68,9 +68,7 @@ void runAlign(const AlignOptions& o) {
     // this line added to it.
     std::optional<dsp::SpeakerAdaptation> speaker;
     if (!o.speaker.empty()) {
-        speaker.emplace(templates);
-        speaker->learnNetworks(o.aligner.config.speakerNetworkEpochs,
-                               o.aligner.config.speakerNetworkRate);
+        speaker.emplace(dsp::carriedVoice(templates, o.aligner.config));
         if (std::filesystem::exists(o.speaker)) speaker->load(o.speaker);
     }
     EspeakSynthesizer synth;

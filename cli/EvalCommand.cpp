@@ -135,10 +135,10 @@ struct Evaluator {
     std::pair<PhonemeSchedule, LevelTrack> schedule(const CorpusItem& item) const {
         dsp::SpeakerAdaptation* speaker = nullptr;
         if (o.adaptSpeaker) {
-            auto [it, fresh] = speakers.try_emplace(item.speaker, templates);
-            if (fresh)
-                it->second.learnNetworks(o.aligner.config.speakerNetworkEpochs,
-                                         o.aligner.config.speakerNetworkRate);
+            auto it = speakers.find(item.speaker);
+            if (it == speakers.end())
+                it = speakers.emplace(item.speaker, dsp::carriedVoice(templates, o.aligner.config))
+                         .first;
             speaker = &it->second;
         }
         if (!o.align) return analyse(item, speaker, true);

@@ -2,20 +2,9 @@
 
 namespace lipsyncd::daemon {
 
-namespace {
-// A voice that has heard nothing yet, and will train the networks as the aligner's carried
-// voice does (AlignerConfig::speakerNetworkEpochs).
-dsp::SpeakerAdaptation freshVoice(const dsp::TemplateSet& base) {
-    dsp::SpeakerAdaptation voice(base);
-    const dsp::AlignerConfig aligner;
-    voice.learnNetworks(aligner.speakerNetworkEpochs, aligner.speakerNetworkRate);
-    return voice;
-}
-}  // namespace
-
 ShowSpeaker::ShowSpeaker(const dsp::TemplateSet& base, std::filesystem::path file,
                          const std::function<void(const std::string&)>& log)
-    : file_(std::move(file)), voice_(freshVoice(base)) {
+    : file_(std::move(file)), voice_(dsp::carriedVoice(base, {})) {
     std::error_code ec;
     if (file_.empty() || !std::filesystem::exists(file_, ec)) return;
     try {
@@ -72,7 +61,7 @@ dsp::TemplateSet ShowSpeaker::templates() const {
 void ShowSpeaker::reset() {
     {
         const std::lock_guard lock(mutex_);
-        voice_ = freshVoice(voice_.base());
+        voice_ = dsp::carriedVoice(voice_.base(), {});
         ++generation_;
         lines_ = 0;
     }

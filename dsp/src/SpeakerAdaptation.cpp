@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <lipsyncd/dsp.hpp>
+#include <utility>
 
 #include "TemplateMatrix.hpp"
 
@@ -78,6 +79,12 @@ void SpeakerAdaptation::add(std::span<const FrameFeatures> frames, const Phoneme
         }
     }
     trainNetworks(frames, segments);
+}
+
+SpeakerAdaptation carriedVoice(TemplateSet base, const AlignerConfig& config) {
+    SpeakerAdaptation voice(std::move(base));
+    voice.learnNetworks(config.speakerNetworkEpochs, config.speakerNetworkRate);
+    return voice;
 }
 
 void SpeakerAdaptation::learnNetworks(int epochs, float rate) {

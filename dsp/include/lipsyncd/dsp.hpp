@@ -1044,6 +1044,11 @@ class SpeakerAdaptation {
     std::size_t frames_ = 0;
 };
 
+// A voice to carry from line to line (the service's show voice, `eval --adapt-speaker`, `align
+// --speaker`): nothing heard yet, and each line added trains its networks further as `config`
+// says (AlignerConfig::speakerNetworkEpochs, speakerNetworkRate).
+SpeakerAdaptation carriedVoice(TemplateSet base, const AlignerConfig& config);
+
 // Frame-synchronous Viterbi over the script's phonemes (a chain of minimum-duration states and
 // a geometric tail per phoneme: Rabiner 1989, section IV.D), with an optional pause and an
 // optional filler between words and word skips, beam-pruned; the path is committed in windows
