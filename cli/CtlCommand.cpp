@@ -101,7 +101,8 @@ nlohmann::json requestFrom(const CtlOptions& o) {
     if (o.channel >= 0 && command->name == "play") r["channel"] = o.channel;
     if (!o.voice.empty() && command->name == "say") r["voice"] = o.voice;
     if (!o.textFile.empty()) {
-        if (command->name != "play") throw CLI::ValidationError("--text-file", "is for play");
+        if (command->name != "play" && command->name != "line")
+            throw CLI::ValidationError("--text-file", "is for play and line");
         std::ifstream in(o.textFile);
         if (!in) throw InputError(o.textFile + ": cannot read");
         std::ostringstream words;
@@ -142,7 +143,8 @@ void addCtlCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voice, "say: espeak-ng voice");
     cmd->add_option("--text-file", o->textFile,
                     "play: the words spoken in the file, aligned instead of recognised "
-                    "(default: FILE.txt beside the file, when there is one)");
+                    "(default: FILE.txt beside the file, when there is one); line: the words "
+                    "the performer says next");
     cmd->add_option("--timeout", o->timeout, "Seconds to wait for the daemon at each step")
         ->capture_default_str()
         ->check(CLI::Range(0.05, 3600.0));

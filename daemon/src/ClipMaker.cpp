@@ -10,6 +10,7 @@
 #include <lipsyncd/tts.hpp>
 #include <optional>
 
+#include "MemoryWav.hpp"
 #include "ShowSpeaker.hpp"
 
 namespace lipsyncd::daemon {
@@ -89,16 +90,18 @@ std::vector<std::int16_t> decodeForPlayback(const std::filesystem::path& file,
 }  // namespace
 
 namespace {
-// What a played line taught the show's voice, kept (and written to its file), and said.
-void learnFrom(ShowSpeaker& speaker, const std::filesystem::path& file, ShowSpeaker::Lesson lesson,
+// What a line taught the show's voice, kept (and written to its file), and said. False when it
+// taught nothing (no frame placed, or a reset came in between).
+bool learnFrom(ShowSpeaker& speaker, const std::string& name, ShowSpeaker::Lesson lesson,
                const std::function<void(const std::string&)>& log) {
     const auto done = speaker.finish(std::move(lesson));
     if (!done.saveProblem.empty())
         log("the show's voice is not kept for a restart: " + done.saveProblem);
-    if (!done.learnt) return;
+    if (!done.learnt) return false;
     const auto heard = speaker.heard();
-    log(file.string() + ": the show's voice learnt from " + std::to_string(heard.lines) +
-        " line(s), " + std::to_string(heard.frames) + " frames");
+    log(name + ": the show's voice learnt from " + std::to_string(heard.lines) + " line(s), " +
+        std::to_string(heard.frames) + " frames");
+    return true;
 }
 }  // namespace
 
@@ -119,7 +122,7 @@ Clip ClipMaker::fromFile(const std::filesystem::path& file, int channel, EspeakS
     const auto schedule =
         scheduleForClip(synth, file, knownText, impl_->config.voice, impl_->templates, decode, say,
                         &levels, lesson ? &lesson->voice : nullptr);
-    if (lesson) learnFrom(*impl_->speaker, file, std::move(*lesson), say);
+    if (lesson) learnFrom(*impl_->speaker, file.string(), std::move(*lesson), say);
     clip.weights = impl_->runtime.animate(schedule, &levels);
     dsp::DecodeOptions play;
     play.skipChannel = channel;
@@ -142,6 +145,40 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
     clip.weights = impl_->runtime.animate(
         mapSchedule(speech.phonemes, espeakMapForVoice(v), nullptr), &levels);
     return clip;
+}
+
+namespace {
+std::string lineName(const std::string& text) {
+    constexpr std::size_t kShown = 40;
+    return "live line '" + (text.size() > kShown ? text.substr(0, kShown) + "..." : text) + "'";
+}
+}  // namespace
+
+// As a played file with its words teaches the voice (fromFile), from samples kept in memory.
+ClipMaker::LineLesson ClipMaker::learnFromLine(
+    std::span<const float> samples, int rate, const std::string& text, EspeakSynthesizer& synth,
+    const std::function<void(const std::string&)>& log) const {
+    if (!impl_->speaker) return {false, "adapt_speaker is off in the config"};
+    const auto say = log ? log : [](const std::string&) {};
+    const auto name = lineName(text);
+    const MemoryWav wav(samples, rate);
+    auto lesson = impl_->speaker->startLesson();
+    dsp::AlignFileResult r;
+    try {
+        r = alignText(synth, wav.path(), text, impl_->config.voice, impl_->templates, {}, {}, {},
+                      std::nullopt, true, &lesson.voice);
+    } catch (const InputError& e) {
+        return {false, wav.named(e.what(), name)};
+    }
+    for (const auto& w : r.warnings) say(wav.named(w, name));
+    const auto placed = std::count_if(r.alignment.words.begin(), r.alignment.words.end(),
+                                      [](const dsp::AlignedWord& w) { return w.placed; });
+    const auto words = std::to_string(placed) + " of " + std::to_string(r.alignment.words.size()) +
+                       " words placed";
+    if (r.fellBack || placed == 0) return {false, words + ": nothing learnt"};
+    if (!learnFrom(*impl_->speaker, name, std::move(lesson), say))
+        return {false, words + ", but the voice was reset meanwhile"};
+    return {true, words};
 }
 
 }  // namespace lipsyncd::daemon

@@ -29,9 +29,9 @@ double checkAudioFile(const std::filesystem::path& file, double maxSeconds) {
     return seconds;
 }
 
-void checkText(const std::string& text, std::size_t maxBytes) {
+void checkText(const std::string& text, std::size_t maxBytes, const std::string& command) {
     if (text.size() > maxBytes)
-        throw InputError("say: " + std::to_string(text.size()) +
+        throw InputError(command + ": " + std::to_string(text.size()) +
                          " bytes of text is more than max_text_bytes (" + std::to_string(maxBytes) +
                          " in the config)");
 }

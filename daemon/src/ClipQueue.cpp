@@ -10,6 +10,8 @@
 #include <lipsyncd/tts.hpp>
 #include <utility>
 
+#include "DaemonCore.hpp"
+
 namespace lipsyncd::daemon {
 
 namespace {
@@ -102,6 +104,8 @@ std::size_t ClipQueue::bytesHeld() const {
                  r.voice.capacity() + (r.knownText ? r.knownText->capacity() : 0);
         if (j.clip) bytes += bytesOf(*j.clip);
     }
+    for (const auto& l : lines_)
+        bytes += sizeof l + l.line.text.capacity() + l.line.samples.capacity() * sizeof(float);
     return bytes;
 }
 
@@ -110,14 +114,58 @@ std::vector<std::string> ClipQueue::takeFailures() {
     return std::exchange(failures_, {});
 }
 
+bool ClipQueue::learn(LineRequest request) {
+    bool kept = true;
+    {
+        std::lock_guard lock(mutex_);
+        if (lines_.size() >= kMaxWaitingLines) {
+            lines_.pop_front();
+            kept = false;
+        }
+        lines_.push_back(std::move(request));
+    }
+    wake_.notify_all();
+    return kept;
+}
+
+std::vector<LineOutcome> ClipQueue::takeLineOutcomes() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(lineOutcomes_, {});
+}
+
+bool ClipQueue::clipToMake() const {
+    return !jobs_.empty() && !jobs_.front().clip && !jobs_.front().preparing;
+}
+
+void ClipQueue::learnNextLine(std::unique_lock<std::mutex>& lock,
+                              std::unique_ptr<EspeakSynthesizer>& synth) {
+    auto request = std::move(lines_.front());
+    lines_.pop_front();
+    lock.unlock();
+    LineOutcome outcome{request.line.text, {}};
+    try {
+        if (!synth) synth = std::make_unique<EspeakSynthesizer>();  // one a process (espeak-ng)
+        const auto& l = request.line;
+        outcome.lesson = request.maker->learnFromLine(l.samples, l.rate, l.text, *synth, logInfo);
+    } catch (const std::exception& e) {
+        outcome.lesson = {false, e.what()};
+    }
+    request = {};  // its samples go before the lock is taken again
+    ::malloc_trim(0);
+    lock.lock();
+    lineOutcomes_.push_back(std::move(outcome));
+}
+
 void ClipQueue::work() {
     std::unique_ptr<EspeakSynthesizer> synth;  // this thread's, for the process's life
     std::unique_lock lock(mutex_);
     for (;;) {
-        wake_.wait(lock, [&] {
-            return stopping_ || (!jobs_.empty() && !jobs_.front().clip && !jobs_.front().preparing);
-        });
+        wake_.wait(lock, [&] { return stopping_ || !lines_.empty() || clipToMake(); });
         if (stopping_) return;
+        if (!lines_.empty()) {
+            learnNextLine(lock, synth);
+            continue;
+        }
         jobs_.front().preparing = true;
         const auto request = jobs_.front().request;
         const auto generation = generation_;

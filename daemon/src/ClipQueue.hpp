@@ -14,6 +14,8 @@
 #include <thread>
 #include <vector>
 
+#include "LiveMode.hpp"
+
 namespace lipsyncd::daemon {
 
 // One play or say request, checked and bounded, not yet prepared.
@@ -27,6 +29,16 @@ struct ClipRequest {
     std::optional<std::string> knownText;
     double maxSeconds = 30;                  // the config's limit on a clip's length
     std::shared_ptr<const ClipMaker> maker;  // the config's pieces when it was asked for
+};
+
+// A line said live, over, waiting to teach the show's voice (`line`).
+struct LineRequest {
+    LiveLine line;
+    std::shared_ptr<const ClipMaker> maker;  // the config's pieces when the line began
+};
+struct LineOutcome {
+    std::string text;
+    ClipMaker::LineLesson lesson;
 };
 
 class ClipQueue {
@@ -51,6 +63,13 @@ class ClipQueue {
     // Requests whose preparation failed since the last call: "NAME: why".
     std::vector<std::string> takeFailures();
 
+    // A line said live, to align on its words and learn from: the worker takes it before the
+    // next clip (a line takes about a tenth of a second). At most kMaxWaitingLines wait; one
+    // more drops the oldest (false).
+    static constexpr std::size_t kMaxWaitingLines = 4;
+    bool learn(LineRequest request);
+    std::vector<LineOutcome> takeLineOutcomes();  // what the lines taught since the last call
+
   private:
     struct Job {
         ClipRequest request;
@@ -58,11 +77,16 @@ class ClipQueue {
         bool preparing = false;
     };
     void work();
+    bool clipToMake() const;  // the front request waits for the worker (mutex_ held)
+    void learnNextLine(std::unique_lock<std::mutex>& lock,
+                       std::unique_ptr<EspeakSynthesizer>& synth);
 
     mutable std::mutex mutex_;
     std::condition_variable wake_;
     std::deque<Job> jobs_;
     std::vector<std::string> failures_;
+    std::deque<LineRequest> lines_;
+    std::vector<LineOutcome> lineOutcomes_;
     std::size_t capacity_;
     std::uint64_t generation_ = 0;  // bumped by clear(): a result from before is dropped
     bool stopping_ = false;
@@ -74,7 +98,8 @@ std::size_t bytesOf(const Clip& clip);
 
 // Request-time checks (cheap: a stat and an audio header). InputError saying what is wrong.
 double checkAudioFile(const std::filesystem::path& file, double maxSeconds);  // its duration
-void checkText(const std::string& text, std::size_t maxBytes);
+// `command` names the request in the message.
+void checkText(const std::string& text, std::size_t maxBytes, const std::string& command);
 
 // Decodes and analyses a file, or synthesises text (`synth` is made on first use and kept:
 // espeak-ng allows one per process). InputError naming the file or text when it cannot.

@@ -34,11 +34,19 @@ constexpr ControlArg kPoseArgs[] = {
 constexpr ControlArg kSpeakerArgs[] = {
     {"action", Type::String, false, 16, 0, 0, "show (default) or reset (forget the voice)"},
 };
+constexpr ControlArg kLineArgs[] = {
+    {"text", Type::String, false, kMaxText, 0, 0,
+     "the words the performer says next, live (none: the line being heard is over)"},
+};
 constexpr ControlArg kOnArg[] = {
     {"on", Type::Boolean, false, 0, 0, 0, "on or off (default on)"},
 };
 
 constexpr ControlCommand kCommands[] = {
+    {"line",
+     "line [TEXT]: the performer says TEXT live next; once it is over (the next line, `line` "
+     "alone, live off) its words teach the show's voice",
+     "text", kLineArgs},
     {"live", "live on|off: follow the microphone", "on", kOnArg},
     {"play", "play FILE: queue an audio file", "file", kPlayArgs},
     {"pose", "pose NAME=WEIGHT...: hold the mouth in a pose for 0.25 s (not while a clip plays)",

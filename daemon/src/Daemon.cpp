@@ -103,6 +103,7 @@ void Daemon::Impl::reportFailures() {
         logWarning("cannot play " + f);
         control->broadcast(json{{"event", "failed"}, {"error", f}});
     }
+    reportLines();
 }
 
 void Daemon::Impl::restNow() {

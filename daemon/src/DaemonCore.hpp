@@ -48,6 +48,10 @@ struct Daemon::Impl {
     nlohmann::json say(const nlohmann::json& request);
     nlohmann::json stop();
     nlohmann::json setLive(bool on);
+    nlohmann::json line(const nlohmann::json& request);  // LiveLines.cpp
+    // A live line that is over goes to the worker to teach the show's voice; its name, or null.
+    nlohmann::json learnLine(std::optional<LiveLine> over);
+    void reportLines();  // what the lines taught: logged by the worker, sent to subscribers
     nlohmann::json holdPose(const nlohmann::json& request);  // PoseRequest.cpp
 
     // Events.cpp
@@ -55,6 +59,7 @@ struct Daemon::Impl {
     std::string_view frameEvent(double t);  // this tick's frame event line (no allocation)
     void setupChanged();                    // a new setup: its pose and actuator names
     nlohmann::json statusReply() const;
+    nlohmann::json lineReply() const;     // the live line being heard, or null
     nlohmann::json speakerReply() const;  // what the show's voice has learnt (status, speaker)
     nlohmann::json speaker(const std::string& action);
 };

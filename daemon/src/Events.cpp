@@ -20,8 +20,16 @@ void Daemon::Impl::setupChanged() {
     frameWriter.setNames(setup->clips->poseNames(), actuators);
 }
 
+// The live line being heard: its words and how much of it has been kept.
+json Daemon::Impl::lineReply() const {
+    const auto* line = live ? live->line() : nullptr;
+    if (!line) return nullptr;
+    return {{"text", line->text}, {"seconds", line->seconds()}, {"full", line->full}};
+}
+
 json Daemon::Impl::statusReply() const {
     const auto* clip = player.clip();
+    const auto* line = live ? live->line() : nullptr;
     const auto& config = setup->config;
     // End to end: a clip's sample handed to the device until it is heard (the mouth is driven
     // `lead` ahead of it, so the servo arrives with it); live, a sound at the microphone until
@@ -45,11 +53,15 @@ json Daemon::Impl::statusReply() const {
             {"at_rest", setup->driver->atRest()},
             {"live", live.has_value()},
             {"live_started", live ? live->started() : -1.0},
+            {"live_line", lineReply()},
             {"latency", latency},
             {"speaker", speakerReply()},
             // What clips hold: the one playing, and the queue (one made ready ahead at most).
+            // (queue_bytes counts the live lines waiting to be learnt too.)
             {"memory",
-             {{"playing_bytes", clip ? bytesOf(*clip) : 0}, {"queue_bytes", queue.bytesHeld()}}}};
+             {{"playing_bytes", clip ? bytesOf(*clip) : 0},
+              {"queue_bytes", queue.bytesHeld()},
+              {"live_line_bytes", line ? line->samples.capacity() * sizeof(float) : 0}}}};
 }
 
 }  // namespace lipsyncd::daemon

@@ -22,6 +22,7 @@ json Daemon::Impl::handle(const json& r) {
             return {{"ok", true}, {"config", configFile.string()}};
         }
         if (cmd == "live") return setLive(r.value("on", true));
+        if (cmd == "line") return line(r);
         if (cmd == "pose") return holdPose(r);
         if (cmd == "speaker") return speaker(r.value("action", std::string("show")));
         return {{"ok", false}, {"error", cmd + ": only on a connection (subscribe)"}};
@@ -44,7 +45,7 @@ json Daemon::Impl::play(const json& r) {
     request.channel = r.value("channel", -1);
     if (r.contains("text")) {
         request.knownText = r["text"].get<std::string>();
-        checkText(*request.knownText, setup->config.maxTextBytes);
+        checkText(*request.knownText, setup->config.maxTextBytes, "play");
     }
     request.name = request.file.string();
     request.maxSeconds = setup->config.maxClipSeconds;
@@ -57,7 +58,7 @@ json Daemon::Impl::play(const json& r) {
 json Daemon::Impl::say(const json& r) {
     ClipRequest request;
     request.text = r["text"].get<std::string>();
-    checkText(request.text, setup->config.maxTextBytes);
+    checkText(request.text, setup->config.maxTextBytes, "say");
     request.voice = r.value("voice", setup->config.voice);
     request.name = "say: " + request.text;
     request.maxSeconds = setup->config.maxClipSeconds;
@@ -76,9 +77,10 @@ json Daemon::Impl::stop() {
 
 json Daemon::Impl::setLive(bool on) {
     if (!on) {
+        const auto learning = live ? learnLine(live->endLine()) : json(nullptr);
         live.reset();
         status("live off");
-        return {{"ok", true}, {"live", false}};
+        return {{"ok", true}, {"live", false}, {"learning", learning}};
     }
     if (!live) {
         live.emplace(setup->config, setup->clips, now());

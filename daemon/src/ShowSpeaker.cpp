@@ -73,7 +73,7 @@ void ShowSpeaker::reset() {
 
 ShowSpeaker::Heard ShowSpeaker::heard() const {
     const std::lock_guard lock(mutex_);
-    return {lines_, voice_.frames(), voice_.networksTrained()};
+    return {lines_, voice_.frames(), voice_.networksTrained(), generation_};
 }
 
 }  // namespace lipsyncd::daemon

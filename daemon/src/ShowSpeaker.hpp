@@ -45,6 +45,7 @@ class ShowSpeaker {
         std::size_t frames = 0;  // frames learnt
         // Its networks trained further (AlignerConfig::speakerNetworkEpochs).
         bool networks = false;
+        std::uint64_t generation = 0;  // counts the resets: (generation, lines) names a voice
     };
     Heard heard() const;
     const std::filesystem::path& file() const { return file_; }

@@ -175,6 +175,15 @@ class ClipMaker {
     Clip fromText(EspeakSynthesizer& synth, const std::string& text, const std::string& voice,
                   double maxSeconds = 0) const;
     const std::vector<std::string>& poseNames() const;
+    // A line said live (`line`): its sound aligned on its words, and the frames the alignment
+    // placed taught to the show's voice, as a played file with words teaches it.
+    struct LineLesson {
+        bool learnt = false;
+        std::string detail;  // how many words were placed, or why nothing was learnt
+    };
+    LineLesson learnFromLine(std::span<const float> samples, int rate, const std::string& text,
+                             EspeakSynthesizer& synth,
+                             const std::function<void(const std::string&)>& log = {}) const;
     // The voice learnt from the show's lines with words (null: adapt_speaker = false). Files
     // without words and live input use it too.
     ShowSpeaker* speaker() const;
