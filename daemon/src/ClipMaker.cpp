@@ -10,6 +10,7 @@
 #include <lipsyncd/tts.hpp>
 #include <optional>
 
+#include "LiveMode.hpp"
 #include "MemoryWav.hpp"
 #include "ShowSpeaker.hpp"
 
@@ -147,20 +148,13 @@ Clip ClipMaker::fromText(EspeakSynthesizer& synth, const std::string& text,
     return clip;
 }
 
-namespace {
-std::string lineName(const std::string& text) {
-    constexpr std::size_t kShown = 40;
-    return "live line '" + (text.size() > kShown ? text.substr(0, kShown) + "..." : text) + "'";
-}
-}  // namespace
-
 // As a played file with its words teaches the voice (fromFile), from samples kept in memory.
 ClipMaker::LineLesson ClipMaker::learnFromLine(
     std::span<const float> samples, int rate, const std::string& text, EspeakSynthesizer& synth,
     const std::function<void(const std::string&)>& log) const {
     if (!impl_->speaker) return {false, "adapt_speaker is off in the config"};
     const auto say = log ? log : [](const std::string&) {};
-    const auto name = lineName(text);
+    const auto name = "live line " + shownLine(text);
     const MemoryWav wav(samples, rate);
     auto lesson = impl_->speaker->startLesson();
     dsp::AlignFileResult r;

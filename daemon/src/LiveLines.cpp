@@ -23,14 +23,14 @@ json Daemon::Impl::line(const json& r) {
         return {{"ok", false}, {"error", "line: \"text\" is blank (no text: the line is over)"}};
     checkText(text, setup->config.maxTextBytes, "line");
     const auto learning = learnLine(live->beginLine(text, setup->config.maxClipSeconds));
-    status("live line: " + text);
+    status("live line " + shownLine(text));
     return {{"ok", true}, {"line", text}, {"learning", learning}};
 }
 
 json Daemon::Impl::learnLine(std::optional<LiveLine> over) {
     if (!over || over->samples.empty() || !setup->clips->speaker()) return nullptr;
     if (over->full)
-        logWarning("live line '" + over->text + "': longer than max_clip_seconds (" +
+        logWarning("live line " + shownLine(over->text) + ": longer than max_clip_seconds (" +
                    std::to_string(setup->config.maxClipSeconds) +
                    " s in the config); learnt from its start");
     const json name = over->text;
@@ -41,7 +41,7 @@ json Daemon::Impl::learnLine(std::optional<LiveLine> over) {
 
 void Daemon::Impl::reportLines() {
     for (const auto& o : queue.takeLineOutcomes()) {
-        if (!o.lesson.learnt) logWarning("live line '" + o.text + "': " + o.lesson.detail);
+        if (!o.lesson.learnt) logWarning("live line " + shownLine(o.text) + ": " + o.lesson.detail);
         control->broadcast(json{{"event", "line"},
                                 {"text", o.text},
                                 {"learnt", o.lesson.learnt},

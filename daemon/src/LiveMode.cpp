@@ -1,6 +1,7 @@
 #include "LiveMode.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "ShowSpeaker.hpp"
@@ -40,6 +41,18 @@ std::span<const float> LiveMode::tick() {
     frames_.times.clear();                     // keep memory flat: only the newest frame matters
     frames_.values.clear();
     return newest_;
+}
+
+std::string shownLine(const std::string& text) {
+    constexpr std::size_t kShown = 40;
+    std::string one;
+    for (const char c : text)
+        if (!std::isspace(static_cast<unsigned char>(c)))
+            one += c;
+        else if (!one.empty() && one.back() != ' ')
+            one += ' ';
+    if (!one.empty() && one.back() == ' ') one.pop_back();
+    return "'" + (one.size() > kShown ? one.substr(0, kShown) + "..." : one) + "'";
 }
 
 std::optional<LiveLine> LiveMode::beginLine(std::string text, double maxSeconds) {

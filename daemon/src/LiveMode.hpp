@@ -22,6 +22,9 @@ struct LiveLine {
     double seconds() const { return rate > 0 ? static_cast<double>(samples.size()) / rate : 0; }
 };
 
+// A line's words as logs and status show them: on one line, long ones cut short.
+std::string shownLine(const std::string& text);
+
 class LiveMode {
   public:
     // Opens the capture device; InputError naming it when it cannot.

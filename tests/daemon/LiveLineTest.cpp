@@ -49,6 +49,12 @@ TEST(LiveLine, ALineWithItsWordsTeachesTheShowsVoiceAndSilenceTeachesNothing) {
     EXPECT_NE(refused.detail.find("adapt_speaker"), std::string::npos) << refused.detail;
 }
 
+// A script file's line ends in a newline, and sd_notify's STATUS must stay on one line.
+TEST(LiveLine, ALineIsShownOnOneLineAndLongOnesCutShort) {
+    EXPECT_EQ(daemon::shownLine("Hello\n  there!\r\n"), "'Hello there!'");
+    EXPECT_EQ(daemon::shownLine(kHelloWords), "'Hello there! I am a puppet. Watch my mou...'");
+}
+
 TEST(LiveLine, LiveModeKeepsALinesSoundUpToItsLimit) {
     daemon::DaemonConfig config;
     config.hardware = false;
