@@ -34,7 +34,7 @@ struct ClipRequest {
 // A line said live, over, waiting to teach the show's voice (`line`).
 struct LineRequest {
     LiveLine line;
-    std::shared_ptr<const ClipMaker> maker;  // the config's pieces when the line began
+    std::shared_ptr<const ClipMaker> maker;  // the config's pieces when the line was over
 };
 struct LineOutcome {
     std::string text;
