@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <future>
 #include <lipsyncd/tts.hpp>
+#include <thread>
 
 namespace lipsyncd {
 namespace {
@@ -24,6 +27,29 @@ EspeakSynthesizer& synthesizer() {
 
 SynthesizedSpeech speak(const std::string& text, int rate = 165) {
     return synthesizer().synthesize({text, "en-us", rate, -1});
+}
+
+// A synthesiser made after another was destroyed speaks too (espeak-ng is initialised once a
+// process: terminating and initialising it again used to hang the second, for ever). Run in a
+// thread with a deadline, so a hang fails the test instead of the run. (ctest runs each test in
+// its own process; in one run of the whole binary the shared synthesiser above may be alive.)
+TEST(EspeakSynthesizer, ASecondSynthesiserAfterTheFirstSpeaksToo) {
+    try {
+        EspeakSynthesizer first;
+        ASSERT_FALSE(first.synthesize({"One.", "en-us", 165, -1}).samples.empty());
+    } catch (const std::runtime_error& e) {
+        GTEST_SKIP() << "another synthesiser is alive in this process: " << e.what();
+    }
+    std::promise<std::size_t> spoken;
+    auto second = spoken.get_future();
+    std::thread([done = std::move(spoken)]() mutable {
+        EspeakSynthesizer again;
+        done.set_value(again.synthesize({"Two.", "en-us", 165, -1}).samples.size());
+    }).detach();  // left behind if it hangs: the process ends with the test run
+    ASSERT_EQ(second.wait_for(std::chrono::seconds(30)), std::future_status::ready)
+        << "the second synthesiser hangs";
+    EXPECT_GT(second.get(), 1000u);
+    EXPECT_THROW(EspeakSynthesizer("/nonexistent/espeak-ng-data"), std::runtime_error);
 }
 
 TEST(EspeakSynthesizer, EveryPhonemeEventFallsInsideTheAudio) {

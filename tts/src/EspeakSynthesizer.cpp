@@ -182,21 +182,45 @@ std::vector<SpokenWord> spokenWords(const std::string& text, const Collector& c,
 
 }  // namespace
 
+namespace {
+// espeak-ng is initialised once a process and never terminated: espeak_Terminate followed by
+// espeak_Initialize hangs (espeak-ng 1.51), so a second synthesiser made after the first was
+// destroyed (a test process, a service whose worker restarts) would wait for ever. The data
+// folder is the first synthesiser's; another asked for later is an error.
+struct Engine {
+    std::string dataPath;
+    int sampleRate = 0;
+};
+const Engine& engine(const std::string& dataPath) {
+    static const Engine once = [&] {
+        Engine e{dataPath,
+                 espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 200,
+                                   dataPath.empty() ? nullptr : dataPath.c_str(),
+                                   espeakINITIALIZE_PHONEME_EVENTS | espeakINITIALIZE_DONT_EXIT)};
+        if (e.sampleRate > 0) espeak_SetSynthCallback(onSynth);
+        return e;
+    }();
+    return once;
+}
+}  // namespace
+
 EspeakSynthesizer::EspeakSynthesizer(const std::string& dataPath) {
     if (gInstanceAlive.exchange(true))
         throw std::runtime_error("espeak-ng: only one synthesiser can exist at a time");
-    sampleRate_ = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 200,
-                                    dataPath.empty() ? nullptr : dataPath.c_str(),
-                                    espeakINITIALIZE_PHONEME_EVENTS | espeakINITIALIZE_DONT_EXIT);
-    if (sampleRate_ <= 0) {
+    const auto& e = engine(dataPath);
+    if (e.sampleRate <= 0) {
         gInstanceAlive = false;
         throw std::runtime_error("espeak-ng: initialisation failed (is espeak-ng-data installed?)");
     }
-    espeak_SetSynthCallback(onSynth);
+    if (e.dataPath != dataPath) {
+        gInstanceAlive = false;
+        throw std::runtime_error("espeak-ng: already initialised on '" + e.dataPath +
+                                 "' in this process, not '" + dataPath + "'");
+    }
+    sampleRate_ = e.sampleRate;
 }
 
 EspeakSynthesizer::~EspeakSynthesizer() {
-    espeak_Terminate();
     gInstanceAlive = false;
 }
 

@@ -42,7 +42,9 @@ struct SynthesizedSpeech {
     bool truncated = false;  // the text was longer than the request's maxSeconds
 };
 
-// espeak-ng holds global state, so one synthesiser exists at a time (a second throws).
+// espeak-ng holds global state, so one synthesiser exists at a time (a second throws). The
+// engine is initialised by the first and never terminated (terminating and initialising it again
+// hangs): one made after another was destroyed goes on with it, on the first one's data folder.
 class EspeakSynthesizer {
   public:
     // dataPath: espeak-ng-data folder, empty for the system default.
