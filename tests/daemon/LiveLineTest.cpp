@@ -63,9 +63,14 @@ TEST(LiveLine, LiveModeKeepsALinesSoundUpToItsLimit) {
     daemon::LiveMode live(config, maker, 0);
     EXPECT_EQ(live.line(), nullptr);
     EXPECT_FALSE(live.beginLine("Hello there!", 30).has_value());
-    std::this_thread::sleep_for(300ms);
-    live.tick();
     ASSERT_NE(live.line(), nullptr);
+    const float* room = live.line()->samples.data();  // reserved at the cue
+    for (int i = 0; i < 30; ++i) {
+        std::this_thread::sleep_for(10ms);
+        live.tick();
+    }
+    ASSERT_NE(live.line(), nullptr);
+    EXPECT_EQ(live.line()->samples.data(), room) << "a tick reallocated the line's samples";
     EXPECT_GT(live.line()->seconds(), 0.2);
     EXPECT_LT(live.line()->seconds(), 2.0);
     EXPECT_FALSE(live.line()->full);
