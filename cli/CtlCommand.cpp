@@ -22,7 +22,7 @@ struct CtlOptions {
     std::vector<std::string> args;
     int channel = -1;
     std::string voice, textFile;
-    bool wait = false;
+    bool wait = false, next = false;
     double timeout = 5;
 };
 
@@ -100,9 +100,13 @@ nlohmann::json requestFrom(const CtlOptions& o) {
     }
     if (o.channel >= 0 && command->name == "play") r["channel"] = o.channel;
     if (!o.voice.empty() && command->name == "say") r["voice"] = o.voice;
+    if (o.next) {
+        if (command->name != "line") throw CLI::ValidationError("--next", "is for line");
+        r["next"] = true;
+    }
     if (!o.textFile.empty()) {
-        if (command->name != "play" && command->name != "line")
-            throw CLI::ValidationError("--text-file", "is for play and line");
+        if (command->name != "play" && command->name != "line" && command->name != "script")
+            throw CLI::ValidationError("--text-file", "is for play, line and script");
         std::ifstream in(o.textFile);
         if (!in) throw InputError(o.textFile + ": cannot read");
         std::ostringstream words;
@@ -144,11 +148,12 @@ void addCtlCommand(CLI::App& app) {
     cmd->add_option("--text-file", o->textFile,
                     "play: the words spoken in the file, aligned instead of recognised "
                     "(default: FILE.txt beside the file, when there is one); line: the words "
-                    "the performer says next");
+                    "the performer says next; script: the show's lines, one a line");
     cmd->add_option("--timeout", o->timeout, "Seconds to wait for the daemon at each step")
         ->capture_default_str()
         ->check(CLI::Range(0.05, 3600.0));
     cmd->add_flag("--wait", o->wait, "Return when nothing plays or is queued any more");
+    cmd->add_flag("--next", o->next, "line: cue the script's next line (loaded with `script`)");
     cmd->add_option("request", o->args, "The request and its arguments")->required();
     cmd->callback([o] { runCtl(*o); });
 }

@@ -14,6 +14,7 @@ using Type = ControlArg::Type;
 // Limits of the protocol itself; the config may set tighter ones (max_text_chars).
 constexpr std::size_t kMaxPath = 4096;
 constexpr std::size_t kMaxText = 16384;
+constexpr std::size_t kMaxScript = 60000;  // within a request line's 64 KiB
 constexpr std::size_t kMaxVoice = 64;
 constexpr std::size_t kMaxPoses = 64;
 
@@ -37,6 +38,11 @@ constexpr ControlArg kSpeakerArgs[] = {
 constexpr ControlArg kLineArgs[] = {
     {"text", Type::String, false, kMaxText, 0, 0,
      "the words the performer says next, live (none: the line being heard is over)"},
+    {"next", Type::Boolean, false, 0, 0, 0, "the script's next line (`script`) instead of text"},
+};
+constexpr ControlArg kScriptArgs[] = {
+    {"text", Type::String, false, kMaxScript, 0, 0,
+     "the show's lines, one a line (blank lines left out); none: where the script stands"},
 };
 constexpr ControlArg kOnArg[] = {
     {"on", Type::Boolean, false, 0, 0, 0, "on or off (default on)"},
@@ -54,6 +60,10 @@ constexpr ControlCommand kCommands[] = {
     {"queue", "queue: what plays and what waits (as status)", "", {}},
     {"reload", "reload: read the configuration again (as SIGHUP)", "", {}},
     {"say", "say TEXT: queue speech", "text", kSayArgs},
+    {"script",
+     "script [TEXT]: the show's lines, one a line, for `line --next` (a pedal's cue); none: where "
+     "it stands",
+     "text", kScriptArgs},
     {"speaker", "speaker [reset]: the show's voice learnt from lines with words, or forget it",
      "action", kSpeakerArgs},
     {"status", "status: what plays, the queue, latency, the mouth", "", {}},

@@ -49,6 +49,12 @@ struct Daemon::Impl {
     nlohmann::json stop();
     nlohmann::json setLive(bool on);
     nlohmann::json line(const nlohmann::json& request);  // LiveLines.cpp
+    nlohmann::json loadScript(const nlohmann::json& request);
+    nlohmann::json scriptReply() const;
+    struct {
+        std::vector<std::string> lines;  // the show's script (`script`), for `line` with next
+        std::size_t next = 0;            // the line `line` with next cues
+    } script;
     // A live line that is over goes to the worker to teach the show's voice; its name, or null.
     nlohmann::json learnLine(std::optional<LiveLine> over);
     void reportLines();  // what the lines taught: logged by the worker, sent to subscribers

@@ -54,6 +54,7 @@ json Daemon::Impl::statusReply() const {
             {"live", live.has_value()},
             {"live_started", live ? live->started() : -1.0},
             {"live_line", lineReply()},
+            {"script", scriptReply()},
             {"latency", latency},
             {"speaker", speakerReply()},
             // What clips hold: the one playing, and the queue (one made ready ahead at most).

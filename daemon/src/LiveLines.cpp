@@ -1,7 +1,10 @@
-// `line`: the performer says a line of the script live. The microphone's sound from the cue on
-// is kept (LiveMode) until the next line, `line` without words, or `live off`; then the worker
-// aligns the line's words on it and the frames it placed teach the show's voice, as a file
-// played with its words does. The next line is heard on what the lines before it taught.
+// `line`: the performer says a line of the script live (its words, or `next`: the next line of
+// the script `script` loaded). The microphone's sound from the cue on is kept (LiveMode) until
+// the next line, `line` without words, or `live off`; then the worker aligns the line's words on
+// it and the frames it placed teach the show's voice, as a file played with its words does. The
+// next line is heard on what the lines before it taught.
+#include <sstream>
+
 #include "DaemonCore.hpp"
 #include "ShowSpeaker.hpp"
 
@@ -16,15 +19,54 @@ json Daemon::Impl::line(const json& r) {
     if (!setup->clips->speaker())
         return {{"ok", false},
                 {"error", "line: adapt_speaker is off in the config: nothing would learn it"}};
-    if (!r.contains("text"))
+    const bool next = r.value("next", false);
+    if (next && r.contains("text"))
+        return {{"ok", false}, {"error", "line: give its text or next, not both"}};
+    if (!next && !r.contains("text"))
         return {{"ok", true}, {"line", nullptr}, {"learning", learnLine(live->endLine())}};
-    const auto& text = r["text"].get_ref<const std::string&>();
+    if (next && script.lines.empty())
+        return {
+            {"ok", false},
+            {"error", "line: no script to take the next line from (`script --text-file` first)"}};
+    if (next && script.next >= script.lines.size())
+        return {{"ok", false},
+                {"error", "line: all " + std::to_string(script.lines.size()) +
+                              " lines of the script are said (`script` again to start over)"}};
+    const auto& text = next ? script.lines[script.next++] : r["text"].get_ref<const std::string&>();
     if (text.find_first_not_of(" \t\r\n") == std::string::npos)
         return {{"ok", false}, {"error", "line: \"text\" is blank (no text: the line is over)"}};
     checkText(text, setup->config.maxTextBytes, "line");
     const auto learning = learnLine(live->beginLine(text, setup->config.maxClipSeconds));
     status("live line " + shownLine(text));
-    return {{"ok", true}, {"line", text}, {"learning", learning}};
+    json reply = {{"ok", true}, {"line", text}, {"learning", learning}};
+    if (next) reply["script_line"] = script.next;  // counted from 1
+    return reply;
+}
+
+// `script`: the show's lines, for cues that say only "next" (a pedal, a show controller).
+json Daemon::Impl::loadScript(const json& r) {
+    if (r.contains("text")) {
+        std::vector<std::string> lines;
+        std::istringstream in(r["text"].get<std::string>());
+        for (std::string l; std::getline(in, l);) {
+            l.erase(l.find_last_not_of(" \t\r") + 1);  // (npos + 1: all of a blank line)
+            if (!l.empty()) lines.push_back(l);
+        }
+        if (lines.empty()) return {{"ok", false}, {"error", "script: \"text\" has no line"}};
+        for (const auto& l : lines) checkText(l, setup->config.maxTextBytes, "script");
+        script.lines = std::move(lines);
+        script.next = 0;
+        status("script of " + std::to_string(script.lines.size()) + " lines");
+    }
+    return {{"ok", true}, {"script", scriptReply()}};
+}
+
+json Daemon::Impl::scriptReply() const {
+    if (script.lines.empty()) return nullptr;
+    const bool more = script.next < script.lines.size();
+    return {{"lines", script.lines.size()},
+            {"next", more ? json(script.next + 1) : json(nullptr)},
+            {"next_text", more ? json(script.lines[script.next]) : json(nullptr)}};
 }
 
 json Daemon::Impl::learnLine(std::optional<LiveLine> over) {

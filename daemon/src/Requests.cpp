@@ -23,6 +23,7 @@ json Daemon::Impl::handle(const json& r) {
         }
         if (cmd == "live") return setLive(r.value("on", true));
         if (cmd == "line") return line(r);
+        if (cmd == "script") return loadScript(r);
         if (cmd == "pose") return holdPose(r);
         if (cmd == "speaker") return speaker(r.value("action", std::string("show")));
         return {{"ok", false}, {"error", cmd + ": only on a connection (subscribe)"}};

@@ -141,13 +141,54 @@ TEST(LiveLine, TheServiceLearnsTheShowsVoiceFromALineSaidLive) {
         << d.log();
 }
 
-TEST(LiveLine, CtlTakesATextFileForPlayAndLineOnly) {
+// A pedal or a show controller sends only "next": the lines come from the script loaded.
+TEST(LiveLine, CuesTakeTheScriptsLinesInTurn) {
+    DaemonProcess d("", "null");
+    d.append("[live]\ndevice = \"file:" + findDataFile("examples/hello.wav").string() + "\"");
+    d.start();
+    Client c(d.socket());
+    ASSERT_TRUE(c.connected());
+    const auto ctl = [&](std::vector<std::string> args) {
+        args.insert(args.begin(), {"ctl", "--socket", d.socket().string()});
+        return runLipsync(args);
+    };
+    ASSERT_TRUE(c.request({{"cmd", "live"}, {"on", true}})["ok"]);
+    const auto none = ctl({"line", "--next"});
+    EXPECT_EQ(none.exitCode, 1);
+    EXPECT_NE(none.err.find("no script"), std::string::npos) << none.err;
+    std::ofstream(d.dir / "scene.txt") << "Hello there!\n\n  \nI am a puppet.\r\n";
+    const auto loaded = ctl({"script", "--text-file", (d.dir / "scene.txt").string()});
+    ASSERT_EQ(loaded.exitCode, 0) << loaded.err;
+    EXPECT_EQ(json::parse(loaded.out)["script"]["lines"], 2) << loaded.out;
+    const auto first = json::parse(ctl({"line", "--next"}).out);
+    EXPECT_EQ(first["line"], "Hello there!");
+    EXPECT_EQ(first["script_line"], 1);
+    const auto status = c.request({{"cmd", "status"}});
+    EXPECT_EQ(status["script"]["next"], 2) << status.dump();
+    // A CRLF file's CR is gone.
+    EXPECT_EQ(status["script"]["next_text"], "I am a puppet.") << status.dump();
+    const auto second = json::parse(ctl({"line", "--next"}).out);
+    EXPECT_EQ(second["learning"], "Hello there!");
+    EXPECT_EQ(second["script_line"], 2);
+    const auto past = ctl({"line", "--next"});
+    EXPECT_EQ(past.exitCode, 1);
+    EXPECT_NE(past.err.find("all 2 lines of the script are said"), std::string::npos) << past.err;
+    const auto both = c.request({{"cmd", "line"}, {"next", true}, {"text", "Hi"}});
+    EXPECT_FALSE(both["ok"]) << both.dump();
+    EXPECT_EQ(ctl({"say", "Hi", "--next"}).exitCode, 2);
+    EXPECT_TRUE(
+        c.request({{"cmd", "script"}, {"text", "\n \n"}}).value("error", "").find("no line") !=
+        std::string::npos);
+    EXPECT_EQ(d.stop(), 0);
+}
+
+TEST(LiveLine, CtlTakesATextFileForPlayLineAndScriptOnly) {
     const auto words = scratchDir("ctl_text_file") / "words.txt";
     std::ofstream(words) << "Hello there!\n";
     const auto r = runLipsync(
         {"ctl", "--socket", "/nonexistent/sock", "say", "Hi", "--text-file", words.string()});
     EXPECT_EQ(r.exitCode, 2) << r.err;
-    EXPECT_NE(r.err.find("is for play and line"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("is for play, line and script"), std::string::npos) << r.err;
 }
 
 TEST(LiveLine, WithoutAdaptSpeakerALineIsRefused) {
