@@ -17,6 +17,12 @@ namespace {
 const char* const kHelloWords =
     "Hello there! I am a puppet. Watch my mouth move when I talk, and wave back at me.";
 
+// The service, its microphone the bundled example line (5.2 s at real-time pace from `live on`).
+void startHearingHello(DaemonProcess& d) {
+    d.append("[live]\ndevice = \"file:" + findDataFile("examples/hello.wav").string() + "\"");
+    d.start();
+}
+
 TEST(LiveLine, ALineWithItsWordsTeachesTheShowsVoiceAndSilenceTeachesNothing) {
     daemon::DaemonConfig config;
     config.hardware = false;
@@ -96,8 +102,7 @@ TEST(LiveLine, LiveModeKeepsALinesSoundUpToItsLimit) {
 // the next cue. The voice learns the line; a line without live input is refused, saying why.
 TEST(LiveLine, TheServiceLearnsTheShowsVoiceFromALineSaidLive) {
     DaemonProcess d("", "null");
-    d.append("[live]\ndevice = \"file:" + findDataFile("examples/hello.wav").string() + "\"");
-    d.start();
+    startHearingHello(d);
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
     const auto early = c.request({{"cmd", "line"}, {"text", kHelloWords}});
@@ -144,8 +149,7 @@ TEST(LiveLine, TheServiceLearnsTheShowsVoiceFromALineSaidLive) {
 // A pedal or a show controller sends only "next": the lines come from the script loaded.
 TEST(LiveLine, CuesTakeTheScriptsLinesInTurn) {
     DaemonProcess d("", "null");
-    d.append("[live]\ndevice = \"file:" + findDataFile("examples/hello.wav").string() + "\"");
-    d.start();
+    startHearingHello(d);
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
     const auto ctl = [&](std::vector<std::string> args) {
@@ -193,8 +197,7 @@ TEST(LiveLine, CtlTakesATextFileForPlayLineAndScriptOnly) {
 
 TEST(LiveLine, WithoutAdaptSpeakerALineIsRefused) {
     DaemonProcess d("adapt_speaker = false\n", "null");
-    d.append("[live]\ndevice = \"file:" + findDataFile("examples/hello.wav").string() + "\"");
-    d.start();
+    startHearingHello(d);
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
     ASSERT_TRUE(c.request({{"cmd", "live"}, {"on", true}})["ok"]);
