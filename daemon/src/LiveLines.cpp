@@ -32,14 +32,14 @@ json Daemon::Impl::line(const json& r) {
         return {{"ok", false},
                 {"error", "line: all " + std::to_string(script.lines.size()) +
                               " lines of the script are said (`script` again to start over)"}};
-    const auto& text = next ? script.lines[script.next++] : r["text"].get_ref<const std::string&>();
+    const auto& text = next ? script.lines[script.next] : r["text"].get_ref<const std::string&>();
     if (text.find_first_not_of(" \t\r\n") == std::string::npos)
         return {{"ok", false}, {"error", "line: \"text\" is blank (no text: the line is over)"}};
     checkText(text, setup->config.maxTextBytes, "line");
     const auto learning = learnLine(live->beginLine(text, setup->config.maxClipSeconds));
     status("live line " + shownLine(text));
     json reply = {{"ok", true}, {"line", text}, {"learning", learning}};
-    if (next) reply["script_line"] = script.next;  // counted from 1
+    if (next) reply["script_line"] = ++script.next;  // counted from 1; the next cue's is after
     return reply;
 }
 
