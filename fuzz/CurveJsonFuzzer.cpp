@@ -10,10 +10,10 @@ using namespace lipsyncd;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     static const auto poses = lipsync::PoseSet::named("facefx");
-    fuzz::MemoryFile file(data, size);
-    if (!file.ok()) return 0;
+    const auto file = fuzz::memoryFileOf(data, size);
+    if (!file) return 0;
     try {
-        const auto curves = lipsync::BigramCurveSet::load(file.path(), poses);
+        const auto curves = lipsync::BigramCurveSet::load(file->path(), poses);
         const PhonemeSchedule schedule = {
             {0.0, 0.1, "sil", 1}, {0.1, 0.25, "aa", 1}, {0.25, 0.3, "bmp", 1}};
         for (const float v : lipsync::animate(schedule, curves, poses, {}).values)

@@ -14,8 +14,6 @@ namespace {
 
 using namespace lipsyncd;
 
-using fuzz::MemoryFile;
-
 std::optional<dsp::RawFormat> rawFormatFrom(const std::uint8_t* header) {
     static constexpr std::array formats{"s8", "u8", "s16", "s24", "s32", "f32", "f64"};
     static constexpr std::array rates{8000, 10000, 16000, 22050, 44100, 48000, 96000, 1};
@@ -33,12 +31,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (size < 4) return 0;
     const bool raw = data[0] & 1;
     const std::size_t skip = raw ? 4 : 1;
-    MemoryFile file(data + skip, size - skip);
-    if (!file.ok()) return 0;
+    const auto file = fuzz::memoryFileOf(data + skip, size - skip);
+    if (!file) return 0;
     dsp::DecodeOptions decode;
     decode.channel = (data[0] >> 1) % 3 == 2 ? 1 : -1;  // sometimes ask for the second channel
     try {
-        const auto result = dsp::analyzeFile(file.path(), templates, PhonemeSet::common(), {},
+        const auto result = dsp::analyzeFile(file->path(), templates, PhonemeSet::common(), {},
                                              decode, raw ? rawFormatFrom(data + 1) : std::nullopt);
         // A schedule, when there is one, is contiguous from 0 and covers the audio.
         double t = 0;

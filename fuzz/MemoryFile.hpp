@@ -1,32 +1,22 @@
-// The fuzz input as a file that loaders taking a path can open, without touching the disk.
+// The fuzz input as a file that loaders taking a path can open, without touching the disk (the
+// core's MemoryFile); none when the memory file cannot be made, and the input is passed over.
 #pragma once
 
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include <cstdint>
-#include <string>
+#include <lipsyncd/core.hpp>
+#include <optional>
+#include <string_view>
 
 namespace lipsyncd::fuzz {
 
-class MemoryFile {
-  public:
-    MemoryFile(const std::uint8_t* data, std::size_t size) : fd_(::memfd_create("fuzz", 0)) {
-        if (fd_ >= 0 && size > 0 && ::write(fd_, data, size) != static_cast<ssize_t>(size)) {
-            ::close(fd_);
-            fd_ = -1;
-        }
+inline std::optional<MemoryFile> memoryFileOf(const std::uint8_t* data, std::size_t size) {
+    try {
+        std::optional<MemoryFile> file(std::in_place, "fuzz");
+        file->write({reinterpret_cast<const char*>(data), size}, "the fuzz input");
+        return file;
+    } catch (const std::runtime_error&) {
+        return std::nullopt;
     }
-    ~MemoryFile() {
-        if (fd_ >= 0) ::close(fd_);
-    }
-    MemoryFile(const MemoryFile&) = delete;
-    MemoryFile& operator=(const MemoryFile&) = delete;
-    bool ok() const { return fd_ >= 0; }
-    std::string path() const { return "/proc/self/fd/" + std::to_string(fd_); }
-
-  private:
-    int fd_;
-};
+}
 
 }  // namespace lipsyncd::fuzz

@@ -10,10 +10,10 @@
 using namespace lipsyncd;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    fuzz::MemoryFile file(data, size);
-    if (!file.ok()) return 0;
+    const auto file = fuzz::memoryFileOf(data, size);
+    if (!file) return 0;
     try {
-        const auto p = output::Puppet::load(file.path());
+        const auto p = output::Puppet::load(file->path());
         if (!(p.leadSeconds >= 0 && p.leadSeconds <= 1)) __builtin_trap();
         for (const auto& a : p.actuators) {
             if (!(std::isfinite(a.min) && std::isfinite(a.max) && a.min < a.max)) __builtin_trap();

@@ -1,13 +1,7 @@
 // The upload as a memory file. Sealed against writes, so what was checked is what is decoded.
 #include "UploadedAudio.hpp"
 
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstdint>
-#include <cstring>
 #include <lipsyncd/core.hpp>
 
 namespace lipsyncd::editor {
@@ -47,30 +41,12 @@ void refuseTruncatedWav(const std::string& b) {
 
 UploadedAudio::UploadedAudio(const std::string& bytes) {
     refuseTruncatedWav(bytes);
-    fd_ = ::memfd_create("lipsync-edit-upload", MFD_CLOEXEC | MFD_ALLOW_SEALING);
-    if (fd_ < 0) throw std::runtime_error(std::string("memfd_create: ") + std::strerror(errno));
-    for (std::size_t done = 0; done < bytes.size();) {
-        const auto n = ::write(fd_, bytes.data() + done, bytes.size() - done);
-        if (n <= 0) {
-            const std::string why = std::strerror(errno);
-            ::close(fd_);
-            throw std::runtime_error("writing the upload to memory: " + why);
-        }
-        done += static_cast<std::size_t>(n);
-    }
-    ::fcntl(fd_, F_ADD_SEALS, F_SEAL_WRITE | F_SEAL_GROW | F_SEAL_SHRINK | F_SEAL_SEAL);
-    path_ = "/proc/self/fd/" + std::to_string(fd_);
-}
-
-UploadedAudio::~UploadedAudio() {
-    if (fd_ >= 0) ::close(fd_);
+    file_.write(bytes, "the upload");
+    file_.seal();
 }
 
 std::string UploadedAudio::named(std::string message) const {
-    const auto name = path_.string();
-    for (auto at = message.find(name); at != std::string::npos; at = message.find(name, at))
-        message.replace(at, name.size(), "the recording");
-    return message;
+    return file_.named(std::move(message), "the recording");
 }
 
 }  // namespace lipsyncd::editor

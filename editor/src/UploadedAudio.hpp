@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <lipsyncd/core.hpp>
 #include <string>
 
 namespace lipsyncd::editor {
@@ -13,17 +14,13 @@ class UploadedAudio {
     // InputError (the request's fault: 400) for a WAV whose RIFF header promises more bytes
     // than came, or when the memory file cannot be made.
     explicit UploadedAudio(const std::string& bytes);
-    ~UploadedAudio();
-    UploadedAudio(const UploadedAudio&) = delete;
-    UploadedAudio& operator=(const UploadedAudio&) = delete;
 
-    const std::filesystem::path& path() const { return path_; }
+    const std::filesystem::path& path() const { return file_.path(); }
     // The decoders' messages name the path: the user knows it as "the recording".
     std::string named(std::string message) const;
 
   private:
-    int fd_ = -1;
-    std::filesystem::path path_;
+    MemoryFile file_{"lipsync-edit-upload"};
 };
 
 }  // namespace lipsyncd::editor

@@ -213,4 +213,31 @@ PoseTrack readPoseTrackCsv(std::istream& in, const std::string& sourceName);
 PoseTrack readPoseTrackCsvFile(const std::filesystem::path& file);  // "-" is stdin
 void writePoseTrackCsv(std::ostream& out, const PoseTrack& track);
 
+// ---------------------------------------------------------------------------------------------
+// Files in memory.
+
+// Bytes held as a file in memory (a memfd) that anything taking a path opens through
+// /proc/self/fd: an uploaded recording, a line heard live. Nothing touches a disk, and no name
+// from a request is ever opened. std::runtime_error when the memory file cannot be made.
+class MemoryFile {
+  public:
+    explicit MemoryFile(const char* name);  // empty
+    ~MemoryFile();
+    MemoryFile(MemoryFile&& other) noexcept;
+    MemoryFile& operator=(MemoryFile&& other) noexcept;
+
+    int fd() const { return fd_; }
+    const std::filesystem::path& path() const { return path_; }
+    // Appends; std::runtime_error "writing WHAT to memory: why" when it cannot.
+    void write(std::string_view bytes, const std::string& what);
+    void seal();  // no more writes, growth or shrinking: what was checked is what is read
+    // `message` with this file's path named as `what` (a reader's messages name the path;
+    // the user knows the file as "the recording" or "live line '...'").
+    std::string named(std::string message, const std::string& what) const;
+
+  private:
+    int fd_ = -1;
+    std::filesystem::path path_;
+};
+
 }  // namespace lipsyncd
