@@ -171,7 +171,7 @@ ClipMaker::LineLesson ClipMaker::learnFromLine(
                        " words placed";
     if (r.fellBack || placed == 0) return {false, words + ": nothing learnt"};
     if (!learnFrom(*impl_->speaker, name, std::move(lesson), say))
-        return {false, words + ", but the voice was reset meanwhile"};
+        return {false, words + ", but nothing learnt (no frame kept, or a reset came in between)"};
     return {true, words};
 }
 
