@@ -1,12 +1,14 @@
 // Forced-alignment speed (issue 11: ≥ 500× real time on one core): the aligner alone on the
-// front end's per-frame distances, and the whole of `lipsync align` over a file (a level pass,
-// decoding, resampling, LPC analysis, classification and the aligner). Speech is espeak-ng's,
-// made in-process: a line said over and over, about 30 s.
+// front end's per-frame distances, the whole of `lipsync align` over a file (a level pass,
+// decoding, resampling, LPC analysis, classification and the aligner), and the aligner as it
+// follows a live line (LineFollower, 100 ms behind: what a live tick adds per frame). Speech is
+// espeak-ng's, made in-process: a line said over and over, about 30 s.
 //
 //   build/bench/align_bench
 //
 // Counters: x_realtime = seconds of audio aligned per second of CPU; frames_held = the most
-// frames of back-pointers the aligner held at once (its memory bound).
+// frames of back-pointers the aligner held at once (its memory bound); per_frame = CPU seconds per
+// 10 ms frame.
 #include <benchmark/benchmark.h>
 
 #include <lipsyncd/dsp.hpp>
@@ -27,8 +29,9 @@ struct Material {
     std::filesystem::path file;
     // Per frame: time, distances, silent.
     std::vector<double> times;
-    std::vector<std::vector<float>> distances;
+    std::vector<std::vector<float>> distances, full;
     std::vector<bool> silent;
+    std::vector<dsp::FrameLabel> labels;
 };
 
 const Material& material() {
@@ -51,7 +54,10 @@ const Material& material() {
             out.times.push_back(f.label.time);
             const auto d = analyzer.templateDistances();
             out.distances.emplace_back(d.begin(), d.end());
+            const auto full = analyzer.distances();
+            out.full.emplace_back(full.begin(), full.end());
             out.silent.push_back(f.label.silent);
+            out.labels.push_back(f.label);
         });
         analyzer.push(out.audio);
         analyzer.finish();
@@ -87,6 +93,26 @@ void WholeFile(benchmark::State& state) {
         seconds * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(WholeFile)->Unit(benchmark::kMillisecond);
+
+void FollowedLine(benchmark::State& state) {
+    const auto& m = material();
+    std::size_t segments = 0;
+    for (auto _ : state) {
+        dsp::LineFollower follower(m.script, PhonemeSet::common(), 0.01, 0.1);
+        follower.onSegment([&](const PhonemeSegment&) { ++segments; });
+        for (std::size_t i = 0; i < m.labels.size(); ++i)
+            follower.push(m.labels[i], m.distances[i], m.full[i]);
+        follower.finish();
+    }
+    benchmark::DoNotOptimize(segments);
+    const double seconds = static_cast<double>(m.audio.size()) / m.rate;
+    const auto runs = static_cast<double>(state.iterations());
+    state.counters["x_realtime"] = benchmark::Counter(seconds * runs, benchmark::Counter::kIsRate);
+    state.counters["per_frame"] =
+        benchmark::Counter(static_cast<double>(m.labels.size()) * runs,
+                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(FollowedLine)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -35,6 +35,9 @@ struct EvalOptions {
     // instead of analysed from the audio alone; voices: "VOICE" for every speaker, or
     // "SPEAKER=VOICE" for one.
     bool align = false, adaptSpeaker = false;
+    // --follow-lag: with --align, each file followed as the service follows a live line with
+    // its words (a fixed-lag alignment this many seconds behind; negative: aligned whole).
+    double followLag = -1;
     AlignerOptions aligner;
     std::vector<std::string> voices;
     FrontEndOptions frontEnd;
@@ -142,6 +145,7 @@ struct Evaluator {
             speaker = &it->second;
         }
         if (!o.align) return analyse(item, speaker, true);
+        if (o.followLag >= 0) return follow(item, speaker);
         if (auto r = align(item, speaker)) return {std::move(r->schedule), std::move(r->levels)};
         return analyse(item, speaker, false);
     }
@@ -179,6 +183,28 @@ struct Evaluator {
         printWarnings("eval", a.warnings);
         if (teach && speaker && wordsBeside(item.audio)) align(item, speaker);
         return {std::move(a.schedule), std::move(a.levels)};
+    }
+
+    // --follow-lag: as the service follows a live line after its cue, on the voice the
+    // speaker's earlier lines taught; once over, the line's words teach the voice in turn.
+    std::pair<PhonemeSchedule, LevelTrack> follow(const CorpusItem& item,
+                                                  dsp::SpeakerAdaptation* speaker) const {
+        const auto own =
+            speaker ? speaker->adaptedIfHeard(o.aligner.config.speakerAdaptationPriorFrames)
+                    : std::nullopt;
+        try {
+            auto a = followText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
+                                voiceFor(item.speaker), own ? *own : templates, o.followLag,
+                                o.frontEnd.config(), o.aligner.config, o.frontEnd.decode(),
+                                o.aligner.reductions);
+            printWarnings("eval", a.warnings);
+            if (speaker) align(item, speaker);
+            return {std::move(a.schedule), std::move(a.levels)};
+        } catch (const InputError& e) {
+            std::cerr << "lipsync eval: " << item.speaker << '/' << item.name
+                      << ": words not used: " << e.what() << "; audio-only analysis\n";
+            return analyse(item, speaker, false);
+        }
     }
 
     // --schedules: the schedule scored, where `lipsync analyze -s` (or align) would write it.
@@ -350,6 +376,10 @@ std::pair<std::string, double> worst(const Report& report, F figure) {
 
 void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
                  const EvalOptions& o) {
+    const bool followed = o.followLag >= 0;
+    const std::string made = followed ? " followed" : " aligned";
+    const std::string lag =
+        followed ? ", lag " + std::to_string(std::lround(o.followLag * 1000)) + " ms" : "";
     if (o.perFile) {
         printHeader(out, "file", o.jaw);
         for (const auto& f : report.files) printRow(out, f.speaker + "/" + f.name, f.score, o.jaw);
@@ -366,13 +396,13 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
         << ", frames " << report.total.schedule.frames << ": accuracy "
         << pct(report.total.schedule.accuracy()) << " (common set), "
         << pct(report.total.schedule.groupAccuracy()) << " (visual groups); worst speaker "
-        << group.first << ' ' << pct(group.second) << (o.align ? " (aligned on the words)" : "")
-        << '\n';
+        << group.first << ' ' << pct(group.second)
+        << (o.align ? " (" + made.substr(1) + " on the words" + lag + ")" : "") << '\n';
     if (o.jaw) {
         const auto audio = worst(report, [](const Score& s) { return s.jaw.audio.r(); });
         const auto labels = worst(report, [](const Score& s) { return s.jaw.labels.r(); });
         out << "jaw through '" << o.puppet << "': r " << fixed2(report.total.jaw.audio.r())
-            << (o.align ? " aligned" : " from audio") << " (worst speaker " << audio.first << ' '
+            << (o.align ? made : " from audio") << " (worst speaker " << audio.first << ' '
             << fixed2(audio.second) << "), " << fixed2(report.total.jaw.labels.r())
             << " from the labels (worst " << labels.first << ' ' << fixed2(labels.second)
             << "), envelope follower " << fixed2(report.total.jaw.envelope.r()) << '\n';
@@ -505,6 +535,12 @@ void addEvalCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voices,
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");
+    addNumberOption(*cmd, "--follow-lag", o->followLag,
+                    "With --align: follow each file as the service follows a live line said "
+                    "after its cue (`lipsync ctl line`), each frame's class decided this many "
+                    "seconds after it (a fixed-lag alignment at the speed the voice reads the "
+                    "words), instead of aligning the whole file",
+                    0.0, dsp::AlignerConfig{}.lookaheadSeconds);
     o->aligner.addTo(*cmd, "With --align");
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "

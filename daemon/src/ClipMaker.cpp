@@ -13,6 +13,7 @@
 #include "LiveMode.hpp"
 #include "MemoryWav.hpp"
 #include "ShowSpeaker.hpp"
+#include "StreamingLive.hpp"
 
 namespace lipsyncd::daemon {
 
@@ -179,86 +180,23 @@ ClipMaker::LineLesson ClipMaker::learnFromLine(
 
 namespace lipsyncd::daemon {
 
-namespace {
-// The front end streaming into the bigram runtime in its causal mode: weights for everything
-// up to the last closed phoneme go out as soon as the phoneme closes.
-class StreamingLive : public ClipMaker::Live {
-  public:
-    StreamingLive(const dsp::TemplateSet& templates, const lipsync::Runtime& runtime, int rate)
-        : analyzer_(templates, PhonemeSet::common(), rate),
-          runtime_(runtime.streaming(0)),
-          poses_(&runtime.poses()),
-          shaper_(runtime.poses()),
-          loudness_(runtime.spec().loudness),
-          heardJaw_(runtime.spec().heardJaw) {
-        analyzer_.onSegment([this](const PhonemeSegment& s) { runtime_.push(s, *out_); });
-        // The newest frame's class stands for the phoneme still open (the segmenter has not
-        // closed it yet): the mouth starts moving without waiting for the phoneme to end.
-        analyzer_.onFrame([this](const dsp::StreamingAnalyzer::Frame& f) {
-            openPhoneme_ = PhonemeSet::common()[static_cast<std::size_t>(f.label.phoneme)].name;
-            openUntil_ = f.label.time;
-            levels_[frames_++ % levels_.size()] = {f.label.time, f.label.energyDb, f.label.jaw};
-        });
-    }
-    void push(std::span<const float> samples, PoseTrack& out) override {
-        out_ = &out;
-        analyzer_.push(samples);
-        if (!openPhoneme_.empty()) runtime_.preview(openPhoneme_, openUntil_, out);
-        if (loudness_ || heardJaw_) shapeNewFrames(out);
-    }
-    double latencySeconds() const override { return analyzer_.latencySeconds(); }
-
-  private:
-    // Each new weight frame takes the jaw heard around its time (the audio frames within 20 ms,
-    // as the offline blend smooths it), then louder speech opens wider by the level of the
-    // audio frame nearest its time, among the recent ones (a fixed ring: nothing allocates).
-    // The newest frames have no later audio yet: their heard jaw is the frames so far.
-    // A weight frame older than the ring (a long phoneme closing late) keeps its own jaw.
-    void shapeNewFrames(PoseTrack& out) {
-        // The caller may clear the track between pushes: frames are told apart by their time.
-        const std::size_t poses = out.poses.size();
-        for (std::size_t f = 0; f < out.frames(); ++f) {
-            const double t = out.times[f];
-            if (t <= shapedUntil_) continue;
-            float db = -120;
-            double nearest = 1e9, jawSum = 0;
-            int jawFrames = 0;
-            for (const auto& l : levels_) {
-                if (std::abs(l.time - t) < nearest) nearest = std::abs(l.time - t), db = l.db;
-                if (std::abs(l.time - t) <= lipsync::kHeardJawSmoothingSeconds / 2)
-                    jawSum += l.jaw, ++jawFrames;
-            }
-            const auto weights = std::span<float>(out.values).subspan(f * poses, poses);
-            if (heardJaw_ && jawFrames > 0)
-                lipsync::blendHeardJaw(*poses_, jawSum / jawFrames, weights);
-            if (loudness_) shaper_.shape(db, t - shapedUntil_, weights);
-            shapedUntil_ = t;
-        }
-    }
-    dsp::StreamingAnalyzer analyzer_;
-    lipsync::StreamingRuntime runtime_;
-    const lipsync::PoseSet* poses_;
-    lipsync::LoudnessShaper shaper_;
-    bool loudness_, heardJaw_;
-    PoseTrack* out_ = nullptr;
-    std::string openPhoneme_;
-    double openUntil_ = 0;
-    struct Level {
-        double time = -1e9;
-        float db = -120;
-        float jaw = 0;  // the jaw the front end heard in the frame (dsp FrameLabel::jaw)
-    };
-    std::array<Level, 32> levels_{};  // the last 320 ms of audio frames
-    std::size_t frames_ = 0;
-    double shapedUntil_ = -1e9;  // the last weight frame shaped
-};
-}  // namespace
-
 std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
     // Live input follows the show's voice as the lines with words before it taught it.
-    if (impl_->speaker)
-        return std::make_unique<StreamingLive>(impl_->speaker->templates(), impl_->runtime, rate);
-    return std::make_unique<StreamingLive>(impl_->templates, impl_->runtime, rate);
+    const auto& templates = impl_->speaker ? impl_->speaker->templates() : impl_->templates;
+    return std::make_unique<StreamingLive>(templates, impl_->runtime, rate,
+                                           impl_->config.followLagSeconds);
+}
+
+std::vector<dsp::ScriptWord> ClipMaker::readLine(const std::string& text,
+                                                 EspeakSynthesizer& synth) const {
+    const auto& voice = impl_->config.voice;
+    const auto set = espeakMapForVoice(voice).phonemeSet();
+    // Live input is analysed in the common set (StreamingLive).
+    if (&PhonemeSet::named(set) != &PhonemeSet::common())
+        throw InputError("voice '" + voice + "' reads words in the '" + set +
+                         "' phoneme set; live input is heard in the common set");
+    std::vector<std::string> warnings;
+    return scriptForVoice(synth, text, voice, &warnings);
 }
 
 }  // namespace lipsyncd::daemon

@@ -156,12 +156,46 @@ void ClipQueue::learnNextLine(std::unique_lock<std::mutex>& lock,
     lineOutcomes_.push_back(std::move(outcome));
 }
 
+void ClipQueue::read(WordsRequest request) {
+    {
+        std::lock_guard lock(mutex_);
+        toRead_ = std::move(request);
+    }
+    wake_.notify_all();
+}
+
+std::optional<WordsRead> ClipQueue::takeWordsRead() {
+    std::unique_lock lock(mutex_, std::try_to_lock);  // the loop never waits for the worker
+    if (!lock) return std::nullopt;
+    return std::exchange(wordsRead_, std::nullopt);
+}
+
+void ClipQueue::readWords(std::unique_lock<std::mutex>& lock,
+                          std::unique_ptr<EspeakSynthesizer>& synth) {
+    auto request = std::move(*toRead_);
+    toRead_.reset();
+    lock.unlock();
+    WordsRead read{request.cue, {}, {}};
+    try {
+        if (!synth) synth = std::make_unique<EspeakSynthesizer>();  // one a process (espeak-ng)
+        read.words = request.maker->readLine(request.text, *synth);
+    } catch (const std::exception& e) {
+        read.error = e.what();
+    }
+    lock.lock();
+    wordsRead_ = std::move(read);
+}
+
 void ClipQueue::work() {
     std::unique_ptr<EspeakSynthesizer> synth;  // this thread's, for the process's life
     std::unique_lock lock(mutex_);
     for (;;) {
-        wake_.wait(lock, [&] { return stopping_ || !lines_.empty() || clipToMake(); });
+        wake_.wait(lock, [&] { return stopping_ || toRead_ || !lines_.empty() || clipToMake(); });
         if (stopping_) return;
+        if (toRead_) {
+            readWords(lock, synth);
+            continue;
+        }
         if (!lines_.empty()) {
             learnNextLine(lock, synth);
             continue;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <lipsyncd/daemon.hpp>
+#include <lipsyncd/dsp.hpp>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -41,6 +42,18 @@ struct LineOutcome {
     ClipMaker::LineLesson lesson;
 };
 
+// A line's words to read for live input to follow (`line` with follow_lines): the cue's number.
+struct WordsRequest {
+    std::uint64_t cue = 0;
+    std::string text;
+    std::shared_ptr<const ClipMaker> maker;
+};
+struct WordsRead {
+    std::uint64_t cue = 0;
+    std::vector<dsp::ScriptWord> words;
+    std::string error;  // why they could not be read (words empty)
+};
+
 class ClipQueue {
   public:
     explicit ClipQueue(std::size_t capacity);
@@ -70,6 +83,11 @@ class ClipQueue {
     bool learn(LineRequest request);
     std::vector<LineOutcome> takeLineOutcomes();  // what the lines taught since the last call
 
+    // A line's words, read before anything else waiting (the line is being said): only the
+    // newest cue's matter, so one still waiting is replaced, and one read is kept till taken.
+    void read(WordsRequest request);
+    std::optional<WordsRead> takeWordsRead();
+
   private:
     struct Job {
         ClipRequest request;
@@ -80,6 +98,7 @@ class ClipQueue {
     bool clipToMake() const;  // the front request waits for the worker (mutex_ held)
     void learnNextLine(std::unique_lock<std::mutex>& lock,
                        std::unique_ptr<EspeakSynthesizer>& synth);
+    void readWords(std::unique_lock<std::mutex>& lock, std::unique_ptr<EspeakSynthesizer>& synth);
 
     mutable std::mutex mutex_;
     std::condition_variable wake_;
@@ -87,6 +106,8 @@ class ClipQueue {
     std::vector<std::string> failures_;
     std::deque<LineRequest> lines_;
     std::vector<LineOutcome> lineOutcomes_;
+    std::optional<WordsRequest> toRead_;
+    std::optional<WordsRead> wordsRead_;
     std::size_t capacity_;
     std::uint64_t generation_ = 0;  // bumped by clear(): a result from before is dropped
     bool stopping_ = false;

@@ -104,6 +104,7 @@ void Daemon::Impl::reportFailures() {
         control->broadcast(json{{"event", "failed"}, {"error", f}});
     }
     reportLines();
+    followLine();
 }
 
 void Daemon::Impl::restNow() {

@@ -87,6 +87,9 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
         const double rate = live->optNumber("rate").value_or(16000);
         if (!(rate >= 8000 && rate <= 96000)) live->fail("rate", "must be within 8000 .. 96000 Hz");
         c.captureRate = static_cast<int>(rate);
+        c.followLines = live->optBool("follow_lines").value_or(c.followLines);
+        // (Beyond a second a mouth reads as out of step with the voice.)
+        c.followLagSeconds = seconds(*live, "follow_lag", c.followLagSeconds, 0, 1);
         live->finish();
     }
     if (const auto control = root.optTable("control")) {

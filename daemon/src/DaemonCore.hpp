@@ -58,6 +58,7 @@ struct Daemon::Impl {
     // A live line that is over goes to the worker to teach the show's voice; its name, or null.
     nlohmann::json learnLine(std::optional<LiveLine> over);
     void reportLines();  // what the lines taught: logged by the worker, sent to subscribers
+    void followLine();   // the words of the line being said, once read: the mouth follows them
     nlohmann::json holdPose(const nlohmann::json& request);  // PoseRequest.cpp
 
     // Events.cpp

@@ -24,7 +24,10 @@ void Daemon::Impl::setupChanged() {
 json Daemon::Impl::lineReply() const {
     const auto* line = live ? live->line() : nullptr;
     if (!line) return nullptr;
-    return {{"text", line->text}, {"seconds", line->seconds()}, {"full", line->full}};
+    return {{"text", line->text},
+            {"seconds", line->seconds()},
+            {"full", line->full},
+            {"following", live->following()}};
 }
 
 json Daemon::Impl::statusReply() const {

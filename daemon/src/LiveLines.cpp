@@ -2,7 +2,10 @@
 // the script `script` loaded). The microphone's sound from the cue on is kept (LiveMode) until
 // the next line, `line` without words, or `live off`; then the worker aligns the line's words on
 // it and the frames it placed teach the show's voice, as a file played with its words does. The
-// next line is heard on what the lines before it taught.
+// next line is heard on what the lines before it taught. While the line is said, the worker
+// reads its words first of all, and the mouth follows them from the cue on ([live]
+// follow_lines, follow_lag): the runtime takes the line's phonemes from a fixed-lag alignment
+// instead of the audio alone.
 #include <sstream>
 
 #include "DaemonCore.hpp"
@@ -16,9 +19,11 @@ json Daemon::Impl::line(const json& r) {
     if (!live)
         return {{"ok", false},
                 {"error", "line: live input is off (`live on` first): a line is heard live"}};
-    if (!setup->clips->speaker())
+    if (!setup->clips->speaker() && !setup->config.followLines)
         return {{"ok", false},
-                {"error", "line: adapt_speaker is off in the config: nothing would learn it"}};
+                {"error",
+                 "line: adapt_speaker and follow_lines are both off in the config: its words "
+                 "would neither teach the voice nor drive the mouth"}};
     const bool next = r.value("next", false);
     if (next && r.contains("text"))
         return {{"ok", false}, {"error", "line: give its text or next, not both"}};
@@ -36,7 +41,11 @@ json Daemon::Impl::line(const json& r) {
     if (text.find_first_not_of(" \t\r\n") == std::string::npos)
         return {{"ok", false}, {"error", "line: \"text\" is blank (no text: the line is over)"}};
     checkText(text, setup->config.maxTextBytes, "line");
-    const auto learning = learnLine(live->beginLine(text, setup->config.maxClipSeconds));
+    // The line's sound is kept only for the voice to learn from.
+    const double keep = setup->clips->speaker() ? setup->config.maxClipSeconds : 0;
+    const bool follow = setup->config.followLines;
+    const auto learning = learnLine(live->beginLine(text, keep, follow));
+    if (follow) queue.read({live->line()->cue, text, setup->clips});
     status("live line " + shownLine(text));
     json reply = {{"ok", true}, {"line", text}, {"learning", learning}};
     if (next) reply["script_line"] = ++script.next;  // counted from 1; the next cue's is after
@@ -79,6 +88,16 @@ json Daemon::Impl::learnLine(std::optional<LiveLine> over) {
     if (!queue.learn({std::move(*over), setup->clips}))
         logWarning("live lines come faster than they are learnt: the oldest waiting is dropped");
     return name;
+}
+
+void Daemon::Impl::followLine() {
+    auto read = queue.takeWordsRead();
+    if (!read || !live || !live->line() || live->line()->cue != read->cue) return;
+    const auto name = "live line " + shownLine(live->line()->text);
+    if (!read->error.empty())
+        logWarning(name + ": the mouth follows the audio alone: " + read->error);
+    else if (live->follow(read->cue, read->words))
+        logInfo(name + ": the mouth follows its " + std::to_string(read->words.size()) + " words");
 }
 
 void Daemon::Impl::reportLines() {

@@ -28,7 +28,7 @@ LiveMode::LiveMode(const DaemonConfig& config, std::shared_ptr<const ClipMaker> 
 std::span<const float> LiveMode::tick() {
     const auto n = capture_->read(buffer_);
     const auto heard = std::span<const float>(buffer_).first(n);
-    if (line_ && !line_->full) {
+    if (line_ && !line_->full && line_->samples.capacity() > 0) {  // (none kept: no room)
         auto& kept = line_->samples;
         const auto room = kept.capacity() - kept.size();
         kept.insert(kept.end(), heard.begin(), heard.begin() + std::min(room, n));
@@ -55,18 +55,25 @@ std::string shownLine(const std::string& text) {
     return "'" + (one.size() > kShown ? one.substr(0, kShown) + "..." : one) + "'";
 }
 
-std::optional<LiveLine> LiveMode::beginLine(std::string text, double maxSeconds) {
+std::optional<LiveLine> LiveMode::beginLine(std::string text, double maxSeconds, bool follow) {
     auto over = endLine();
     followVoice();
+    if (follow) live_->cue(frames_);
     line_.emplace();
     line_->text = std::move(text);
+    line_->cue = ++cues_;
     line_->rate = capture_->rate();
     line_->samples.reserve(static_cast<std::size_t>(std::ceil(maxSeconds * line_->rate)));
     return over;
 }
 
 std::optional<LiveLine> LiveMode::endLine() {
+    live_->endLine(frames_);
     return std::exchange(line_, std::nullopt);
+}
+
+bool LiveMode::follow(std::uint64_t cue, std::span<const dsp::ScriptWord> words) {
+    return line_ && line_->cue == cue && live_->follow(words, frames_);
 }
 
 // A new front end only when the voice has learnt (or forgotten) something since the last one:

@@ -1,6 +1,7 @@
 // Live: capture → streaming front end → causal runtime → the mouth, with the least delay.
 // A line of the script said live (`line` requests) is also kept as it is heard, so that once it
-// is over its words can be aligned on it and teach the show's voice.
+// is over its words can be aligned on it and teach the show's voice; while it is said, once the
+// worker has read its words, the mouth follows them ([live] follow_lines).
 #pragma once
 
 #include <lipsyncd/daemon.hpp>
@@ -16,6 +17,7 @@ namespace lipsyncd::daemon {
 // A line said live: its words, and the sound heard from its cue on.
 struct LiveLine {
     std::string text;
+    std::uint64_t cue = 0;  // counted from 1: which cue began it (the words read belong to one)
     std::vector<float> samples;  // mono, at `rate`: reserved when the line began
     int rate = 0;
     bool full = false;  // stopped at its length limit: what came after was not kept
@@ -36,13 +38,18 @@ class LiveMode {
     double started() const { return started_; }
     double frontEndLatency() const { return live_->latencySeconds(); }
 
-    // A line begins (its words): the sound from now on is kept, at most `maxSeconds` of it.
+    // A line begins (its words): the sound from now on is kept, at most `maxSeconds` of it;
+    // with `follow`, the frames wait for its words (follow()).
     // Returns the line that was being heard, now over. Live input follows the show's voice as
     // the lines so far have taught it from here on (a new front end on it: between lines, so
     // no phoneme is cut).
-    std::optional<LiveLine> beginLine(std::string text, double maxSeconds);
+    std::optional<LiveLine> beginLine(std::string text, double maxSeconds, bool follow = false);
     std::optional<LiveLine> endLine();  // the line being heard is over: it, if there was one
     const LiveLine* line() const { return line_ ? &*line_ : nullptr; }  // being heard
+    // The words of the line `cue` began, read: the mouth follows them from the cue on, if that
+    // line is still being heard (true).
+    bool follow(std::uint64_t cue, std::span<const dsp::ScriptWord> words);
+    bool following() const { return live_->following(); }
 
   private:
     void followVoice();
@@ -55,6 +62,7 @@ class LiveMode {
     std::vector<float> buffer_ = std::vector<float>(96000);
     std::vector<float> newest_;
     std::optional<LiveLine> line_;
+    std::uint64_t cues_ = 0;
     double started_;
 };
 

@@ -8,11 +8,11 @@
 #include <sstream>
 
 #include "AdaptedDistances.hpp"
+#include "AlignerInput.hpp"
 
 namespace lipsyncd::dsp {
 
 namespace {
-constexpr std::size_t kReadBlock = 4096;
 // The level pass reads this many of its 10 ms blocks at once.
 constexpr std::size_t kLevelBlocksPerRead = 64;
 // Speech is what lies within this many dB of the loudest 10 ms block, and above the floor.
@@ -29,30 +29,6 @@ constexpr double kRoomQuantile = 0.05;
 constexpr double kMinTimeScale = 0.5, kMaxTimeScale = 2.0;
 // Audio shorter than this fraction of the script's minimum cannot hold the words.
 constexpr double kTooShortFraction = 0.8;
-
-// What the class network and the set's class bias add to a frame's template distances
-// (FrameClassifier::distances() over templateDistances()), per class; 0 where either is not
-// finite (a class without templates keeps its distance as the templates give it).
-void networkTerm(std::span<const float> templates, std::span<const float> full,
-                 std::span<float> term) {
-    for (std::size_t c = 0; c < term.size(); ++c)
-        term[c] =
-            std::isfinite(templates[c]) && std::isfinite(full[c]) ? full[c] - templates[c] : 0.0f;
-}
-
-// One frame into the aligner: the templates' distances, plus `share` of the network's term
-// (AlignerConfig::classNetworkShare) when it is on; the words' confidences then stay on the
-// templates' own (ForcedAligner::push). `mixed` is room for the sum.
-void pushFrame(ForcedAligner& aligner, double time, std::span<const float> templates,
-               std::span<const float> term, float share, bool silent, std::vector<float>& mixed) {
-    if (share <= 0) {
-        aligner.push(time, templates, silent);
-        return;
-    }
-    mixed.resize(templates.size());
-    for (std::size_t c = 0; c < templates.size(); ++c) mixed[c] = templates[c] + share * term[c];
-    aligner.push(time, mixed, silent, templates);
-}
 
 double scriptSeconds(std::span<const ScriptWord> script) {
     double total = 0;
@@ -317,12 +293,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
         r.levels.jaw.push_back(f.label.jaw);  // the heard jaw, at the aligned share
     });
     analyzer.onSegment([&](const PhonemeSegment& s) { r.audioOnly.push_back(s); });
-    std::vector<float> block(kReadBlock);
-    std::int64_t total = 0;
-    while (const auto n = decoder.read(block)) {
-        analyzer.push(std::span<const float>(block.data(), n));
-        total += static_cast<std::int64_t>(n);
-    }
+    const auto total = analyzer.pushAll(decoder);
     analyzer.finish();
     r.warnings = decoder.warnings();
     r.durationSeconds = static_cast<double>(total) / decoder.sampleRate();

@@ -3,7 +3,9 @@
 // of the class network's scaled likelihoods, Bourlard & Morgan 1994), beam-pruned, with
 // the path committed in windows: every commitSeconds, the best path is traced back and the
 // part older than lookaheadSeconds becomes final; paths that disagree with it there are
-// dropped, so what was committed is never contradicted later.
+// dropped, so what was committed is never contradicted later. Following a line as it is said
+// (followOnly, LineFollower), nothing of the path is kept: the windows only bound the memory,
+// which is reserved up front, and phonemeBack() reads the best partial path a fixed lag back.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -103,6 +105,8 @@ struct ForcedAligner::State {
     std::int64_t totalFrames = -1;  // the input's length, when known (expectFrames)
     std::size_t peakRows = 0;
     bool finished = false;
+    bool keepPath = true;    // false: following (followOnly)
+    std::vector<int> nodes;  // emitPath(): the path's node per frame
 };
 
 namespace {
@@ -194,7 +198,7 @@ void ForcedAligner::State::ancestors(std::int64_t frame, std::span<int> nodes,
 }
 
 void ForcedAligner::State::emitPath(std::int64_t lastFrame, int node) {
-    std::vector<int> nodes(static_cast<std::size_t>(lastFrame - windowStart + 1));
+    nodes.resize(static_cast<std::size_t>(lastFrame - windowStart + 1));
     for (std::int64_t f = lastFrame; f >= windowStart; --f) {
         nodes[static_cast<std::size_t>(f - windowStart)] = node;
         if (f > windowStart) node = ancestor(f, node, f - 1);
@@ -254,7 +258,7 @@ void ForcedAligner::State::commit(std::int64_t keepFrames) {
     if (upTo < windowStart) return;
     const int bestNode = commitFrom();
     const int anchor = ancestor(last, bestNode, upTo);
-    emitPath(upTo, anchor);
+    if (keepPath) emitPath(upTo, anchor);
     alive.clear();
     for (int n = lo; n <= hi; ++n)
         if (delta[n] < kNever) alive.push_back(n);
@@ -309,8 +313,38 @@ Alignment ForcedAligner::finish() {
     }
     const bool complete = endNode >= 0;
     // Without a path through the words, the best partial one still places the words it passed.
-    if (s.windowStart < s.frames) s.emitPath(s.frames - 1, complete ? endNode : bestNode);
+    if (s.keepPath && s.windowStart < s.frames)
+        s.emitPath(s.frames - 1, complete ? endNode : bestNode);
     return s.path.finish(complete);
+}
+
+void ForcedAligner::followOnly() {
+    auto& s = *state_;
+    s.keepPath = false;
+    // A window holds at most lookahead + commit frames (push() commits when it is that full),
+    // each with the back-pointers of at most every node or the beam's widest range.
+    const auto keep = static_cast<std::size_t>(std::lround(s.config.lookaheadSeconds / s.hop));
+    const auto every = std::max<std::size_t>(1, std::lround(s.config.commitSeconds / s.hop));
+    const auto frames = keep + every + 1;
+    const auto nodes = s.graph.nodes.size();
+    const auto perFrame = std::min(nodes, static_cast<std::size_t>(s.config.maxActiveNodes) + 1);
+    s.rows.reserve(frames);
+    s.back.reserve(frames * perFrame);
+    s.excess.reserve(frames * s.set->size());
+    s.alive.reserve(nodes);
+    s.traced.reserve(nodes);
+}
+
+int ForcedAligner::phonemeBack(int lagFrames) const {
+    const auto& s = *state_;
+    if (s.frames == 0) return -1;
+    const std::int64_t last = s.frames - 1;
+    const std::int64_t at = std::max(s.windowStart, last - std::max(0, lagFrames));
+    const int node = s.ancestor(last, firstBest(s.delta, s.lo, s.hi), at);
+    const auto& n = s.graph.nodes[static_cast<std::size_t>(node)];
+    const bool word =
+        n.kind == AlignmentNode::Kind::Phoneme || n.kind == AlignmentNode::Kind::Pause;
+    return word ? n.phoneme : -1;
 }
 
 double ForcedAligner::minimumSeconds() const {

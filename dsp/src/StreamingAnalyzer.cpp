@@ -63,6 +63,16 @@ void StreamingAnalyzer::finish() {
         if (segmentSink_) segmentSink_(seg);
 }
 
+std::int64_t StreamingAnalyzer::pushAll(AudioDecoder& decoder) {
+    std::vector<float> block(kReadBlock);
+    std::int64_t total = 0;
+    while (const auto n = decoder.read(block)) {
+        push(std::span<const float>(block.data(), n));
+        total += static_cast<std::int64_t>(n);
+    }
+    return total;
+}
+
 AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet& templates,
                            const PhonemeSet& set, const FrontEndConfig& config,
                            const DecodeOptions& decode, const std::optional<RawFormat>& raw,
@@ -88,12 +98,7 @@ AnalysisResult analyzeFile(const std::filesystem::path& file, const TemplateSet&
         result.levels.jaw.push_back(f.label.jaw);
         if (keepFrames) result.frames.push_back(f);
     });
-    std::vector<float> block(kReadBlock);
-    std::int64_t total = 0;
-    while (const auto n = decoder.read(block)) {
-        analyzer.push(std::span<const float>(block.data(), n));
-        total += static_cast<std::int64_t>(n);
-    }
+    const auto total = analyzer.pushAll(decoder);
     result.resamplerDelaySeconds = analyzer.resamplerDelaySeconds();
     analyzer.finish();
     result.durationSeconds = static_cast<double>(total) / decoder.sampleRate();

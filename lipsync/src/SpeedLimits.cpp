@@ -32,18 +32,31 @@ float ceilingFor(const PoseSet& poses, std::size_t pose, std::span<const float> 
 }
 }  // namespace
 
-void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const float> previous,
-                PoseCurves& curves, std::size_t fromFrame) {
-    const std::size_t n = poses.size();
-    std::vector<std::size_t> order(n);
+SpeedLimitScratch::SpeedLimitScratch(const PoseSet& poses)
+    : order(poses.size()), prev(poses.size()), now(poses.size()) {
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
         return poses[a].priority > poses[b].priority;
     });
+}
+
+void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const float> previous,
+                PoseCurves& curves, std::size_t fromFrame) {
+    SpeedLimitScratch scratch(poses);
+    limitSpeed(poses, keepConstraints, previous, curves, fromFrame, scratch);
+}
+
+void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const float> previous,
+                PoseCurves& curves, std::size_t fromFrame, SpeedLimitScratch& scratch) {
+    const std::size_t n = poses.size();
     const double dt = 1.0 / curves.rate;
-    std::vector<float> prev(previous.begin(), previous.end()), now(n);
+    auto& prev = scratch.prev;
+    auto& now = scratch.now;
+    prev.assign(previous.begin(), previous.end());
+    // ceilingFor reads `now` of poses not yet placed this frame: as a fresh call, it starts at 0.
+    now.assign(n, 0.0f);
     for (std::size_t f = fromFrame; f < curves.frames; ++f) {
-        for (const std::size_t p : order) {
+        for (const std::size_t p : scratch.order) {
             const auto step = static_cast<float>(poses[p].speedLimit * dt);
             const float lo = std::max(0.0f, prev[p] - step);
             float hi = std::min(1.0f, prev[p] + step);

@@ -3,6 +3,9 @@
 // no later segment can change any more: those older than the newest boundary minus the delay.
 // The window keeps enough past (a segment, the smoothing window and a margin) for every step
 // to see what the offline pass sees, and the speed limit continues from the last frame out.
+// It runs on the live path, every 10 ms: the window, the schedule and the curves live in
+// members whose memory each push reuses, so once they have grown to the longest window seen
+// nothing allocates.
 #include <algorithm>
 #include <cmath>
 #include <lipsyncd/lipsync.hpp>
@@ -17,7 +20,20 @@ StreamingRuntime::StreamingRuntime(const BigramCurveSet& set, const PoseSet& pos
       phonemes_(&phonemes),
       config_(config),
       delay_(std::max(0.0, delaySeconds)),
-      last_(poses.size(), 0.0f) {}
+      last_(poses.size(), 0.0f),
+      curves_(poses.size(), config.outputRate, 0, 0, 0),
+      speed_(poses) {
+    // Room for what a window holds (the delay, the smoothing window and a margin, two segments
+    // more, the causal estimate) at one segment per 10 ms analysis hop, and for its frames with
+    // a phoneme held open for a few seconds. Anything longer grows them once, geometrically.
+    constexpr double kSegmentsPerSecond = 100, kOpenSeconds = 4;
+    const double kept = delay_ + longestWindow() + 0.05;
+    const auto segments = static_cast<std::size_t>(kept * kSegmentsPerSecond) + 4;
+    window_.reserve(segments);
+    schedule_.reserve(segments + 1);
+    const auto frames = static_cast<std::size_t>((kept + kOpenSeconds) * config_.outputRate);
+    for (auto& pose : curves_.values) pose.reserve(frames);
+}
 
 void StreamingRuntime::push(const PhonemeSegment& segment, PoseTrack& out) {
     if (!started_) {
@@ -65,42 +81,58 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
     const auto margin = static_cast<long long>(std::ceil(longestWindow() * rate)) + 2;
     const auto workTo = final ? lastFrame : std::min(known, lastFrame + margin);
     const std::size_t frames = static_cast<std::size_t>(workTo) + 1 - firstFrame;
-    PoseCurves curves(poses_->size(), rate, origin_, firstFrame, frames);
-
-    std::vector<PhonemeSegment> schedule(window_.begin(), window_.end());
-    const bool causal = delay_ == 0 && !final;
-    if (causal) {  // what comes next is unknown: assume the last phoneme goes on, for a typical
-                   // length
-        double total = 0;
-        for (const auto& s : window_) total += s.duration();
-        const double typical = window_.empty() ? 0.1 : total / static_cast<double>(window_.size());
-        if (open) {
-            schedule.push_back(
-                {open->start, std::max(open->end, open->start + typical), open->phoneme, 0});
-        } else {
-            const auto& last = window_.back();
-            schedule.push_back({last.end, last.end + typical, last.phoneme, 0});
-        }
-    }
-    stitchBigrams(schedule, *set_, *phonemes_, curves, {atStart_, final});
+    resetCurves(firstFrame, frames);
+    buildSchedule(delay_ == 0 && !final, open);
+    stitchBigrams(schedule_, *set_, *phonemes_, curves_, {atStart_, final});
     if (config_.smoothing)
         for (std::size_t p = 0; p < poses_->size(); ++p)
-            smoothValleys(curves.values[p], rate, (*poses_)[p].smoothingWindow);
+            smoothValleys(curves_.values[p], rate, (*poses_)[p].smoothingWindow);
     const std::size_t from = emitted_ - firstFrame;
-    if (config_.constraints) applyConstraints(*poses_, curves, from);
+    if (config_.constraints) applyConstraints(*poses_, curves_, from);
     // The newest segment counts as the end: if it is silence, speech may have stopped, and the
     // mouth must not wait for the next segment to find out (a live puppet would hang open).
     if (config_.restInPauses)
-        restInPauses(schedule, *phonemes_, poses_->rest(), curves, from, {atStart_, true});
-    if (config_.speedLimits) limitSpeed(*poses_, config_.constraints, last_, curves, from);
+        restInPauses(schedule_, *phonemes_, poses_->rest(), curves_, from, {atStart_, true});
+    if (config_.speedLimits) limitSpeed(*poses_, config_.constraints, last_, curves_, from, speed_);
 
     const std::size_t end = static_cast<std::size_t>(lastFrame) + 1 - firstFrame;
     for (std::size_t f = from; f < end; ++f) {
-        for (std::size_t p = 0; p < poses_->size(); ++p) last_[p] = curves.values[p][f];
-        out.append(curves.timeOf(f), last_);
+        for (std::size_t p = 0; p < poses_->size(); ++p) last_[p] = curves_.values[p][f];
+        out.append(curves_.timeOf(f), last_);
     }
     emitted_ = static_cast<std::size_t>(lastFrame) + 1;
     dropOldSegments();
+}
+
+// The segments the steps run over: the window, and in the causal mode what comes next, unknown
+// yet: the last phoneme (or the open one) going on for a typical length.
+void StreamingRuntime::buildSchedule(bool causal, const PhonemeSegment* open) {
+    schedule_.assign(window_.begin(), window_.end());
+    if (!causal) return;
+    double total = 0;
+    for (const auto& s : window_) total += s.duration();
+    const double typical = window_.empty() ? 0.1 : total / static_cast<double>(window_.size());
+    if (open) {
+        schedule_.push_back(
+            {open->start, std::max(open->end, open->start + typical), open->phoneme, 0});
+    } else {
+        const auto& last = window_.back();
+        schedule_.push_back({last.end, last.end + typical, last.phoneme, 0});
+    }
+}
+
+// What a fresh PoseCurves(poses, rate, origin_, firstFrame, frames) holds (every value 0), in
+// curves_'s memory. A longer window than any before grows it by at least double, so that a
+// phoneme held open (a long pause heard live) reallocates only now and then, not every tick.
+void StreamingRuntime::resetCurves(std::size_t firstFrame, std::size_t frames) {
+    curves_.startTime = origin_;
+    curves_.firstFrame = firstFrame;
+    curves_.rate = config_.outputRate;
+    curves_.frames = frames;
+    for (auto& pose : curves_.values) {
+        if (pose.capacity() < frames) pose.reserve(std::max(frames, 2 * pose.capacity()));
+        pose.assign(frames, 0.0f);
+    }
 }
 
 // Keeps two segments before the margin: frames inside window_[1] see both bigrams covering them.

@@ -4,33 +4,10 @@
 
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <nlohmann/json.hpp>
 
 #include "../../daemon/src/FrameEvent.hpp"
-
-// Replacing the global operator new/delete pair with malloc/free is what the standard allows;
-// g++ cannot see that the two belong together.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-namespace {
-// Allocations made by this thread while `counting` (the test binary's operator new).
-thread_local bool counting = false;
-thread_local long allocations = 0;
-}  // namespace
-
-void* operator new(std::size_t n) {
-    if (counting) ++allocations;
-    if (void* p = std::malloc(n ? n : 1)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
+#include "../support/AllocationCount.hpp"
 
 namespace lipsyncd::test {
 namespace {
@@ -69,8 +46,7 @@ TEST(FrameEvent, FormattingAllocatesNothing) {
     w.setNames(poses, actuators);
     std::vector<float> weights(poses.size());
     std::vector<output::ActuatorCommand> commands(actuators.size());
-    counting = true;
-    allocations = 0;
+    const AllocationCount count;
     std::size_t bytes = 0;
     for (int f = 0; f < 1000; ++f) {
         for (std::size_t i = 0; i < weights.size(); ++i)  // long, unround numbers
@@ -78,8 +54,7 @@ TEST(FrameEvent, FormattingAllocatesNothing) {
         for (auto& c : commands) c.value = -1e-300 * f - 12345.678901234567;
         bytes += w.format(1e9 + f / 3.0, weights, commands, -f / 7.0).size();
     }
-    counting = false;
-    EXPECT_EQ(allocations, 0);
+    EXPECT_EQ(count.made(), 0);
     EXPECT_GT(bytes, 1000u * 200);
 }
 

@@ -122,6 +122,8 @@ TEST(LiveLine, TheServiceLearnsTheShowsVoiceFromALineSaidLive) {
     std::this_thread::sleep_for(5500ms);  // the line, 5.2 s
     const auto status = c.request({{"cmd", "status"}});
     ASSERT_TRUE(status["live_line"].is_object()) << status.dump();
+    // The worker read the words at the cue: the mouth follows them (follow_lines).
+    EXPECT_TRUE(status["live_line"]["following"]) << status.dump();
     EXPECT_EQ(status["live_line"]["text"], cue["line"]);
     EXPECT_GT(status["live_line"]["seconds"].get<double>(), 5.0);
     // Room for max_clip_seconds (30) of the capture's 22,050 samples a second, reserved at the cue.
@@ -143,6 +145,8 @@ TEST(LiveLine, TheServiceLearnsTheShowsVoiceFromALineSaidLive) {
     EXPECT_NE(d.log().find("live line 'Hello there! I am a puppet. Watch my mou...': the show's "
                            "voice learnt from 1 line(s)"),
               std::string::npos)
+        << d.log();
+    EXPECT_NE(d.log().find("Watch my mou...': the mouth follows its 17 words"), std::string::npos)
         << d.log();
 }
 
@@ -195,16 +199,40 @@ TEST(LiveLine, CtlTakesATextFileForPlayLineAndScriptOnly) {
     EXPECT_NE(r.err.find("is for play, line and script"), std::string::npos) << r.err;
 }
 
-TEST(LiveLine, WithoutAdaptSpeakerALineIsRefused) {
+// Without adapt_speaker a line's words still drive the mouth (follow_lines); without either,
+// a line would serve nothing and is refused, saying why.
+TEST(LiveLine, WithoutAdaptSpeakerALineIsFollowedOnlyAndWithoutEitherRefused) {
     DaemonProcess d("adapt_speaker = false\n", "null");
-    startHearingHello(d);
+    d.append("[live]\ndevice = \"file:" + findDataFile("examples/hello.wav").string() +
+             "\"\nfollow_lines = false");
+    d.start();
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
     ASSERT_TRUE(c.request({{"cmd", "live"}, {"on", true}})["ok"]);
     const auto r = c.request({{"cmd", "line"}, {"text", kHelloWords}});
     EXPECT_FALSE(r["ok"]);
-    EXPECT_NE(r.value("error", "").find("adapt_speaker"), std::string::npos) << r.dump();
+    EXPECT_NE(r.value("error", "").find("adapt_speaker and follow_lines"), std::string::npos)
+        << r.dump();
     EXPECT_EQ(d.stop(), 0);
+
+    DaemonProcess f("adapt_speaker = false\n", "null");
+    startHearingHello(f);
+    Client cf(f.socket());
+    ASSERT_TRUE(cf.connected());
+    ASSERT_TRUE(cf.request({{"cmd", "live"}, {"on", true}})["ok"]);
+    const auto followed = cf.request({{"cmd", "line"}, {"text", kHelloWords}});
+    EXPECT_TRUE(followed["ok"]) << followed.dump();
+    json line = json::object();
+    for (int i = 0; i < 100 && !line.value("following", false); ++i) {
+        std::this_thread::sleep_for(50ms);
+        line = cf.request({{"cmd", "status"}})["live_line"];
+        ASSERT_TRUE(line.is_object()) << line.dump();
+    }
+    EXPECT_TRUE(line.value("following", false)) << line.dump();
+    // Nothing is kept to learn from.
+    EXPECT_EQ(cf.request({{"cmd", "status"}})["memory"]["live_line_bytes"], 0);
+    EXPECT_TRUE(cf.request({{"cmd", "line"}})["learning"].is_null());
+    EXPECT_EQ(f.stop(), 0);
 }
 
 }  // namespace

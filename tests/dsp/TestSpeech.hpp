@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "TestSynth.hpp"
+
 namespace lipsyncd::test {
 
 struct Speech {
@@ -20,8 +22,7 @@ struct Speech {
 
 inline const Speech& testSpeech() {
     static const Speech speech = [] {
-        EspeakSynthesizer synth;
-        const auto s = synth.synthesize(
+        const auto s = espeak().synthesize(
             {"Hello puppet, please open your mouth wide and say something funny.", "en-us", 0, -1});
         Speech out;
         out.rate = s.sampleRate;

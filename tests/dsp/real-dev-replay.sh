@@ -11,7 +11,8 @@
 # instead of the default one. REPLAY_ALIGN=1 scores `lipsync align` on each file's words
 # instead (eval --align), festvox-ru read by espeak-ng's ru voice. REPLAY_ADAPT=1 carries each
 # speaker's voice from file to file (eval --adapt-speaker: what lipsyncd's adapt_speaker gives).
-# REPLAY_CALIBRATE=N calibrates each speaker on its first N files (`lipsync calibrate` on their
+# REPLAY_FOLLOW=LAG (with REPLAY_ALIGN) follows each file as lipsyncd follows a live line said
+# after its cue (eval --follow-lag LAG). REPLAY_CALIBRATE=N calibrates each speaker on its first N files (`lipsync calibrate` on their
 # words: its templates and its vocal-tract-length warp) and scores the rest with that set.
 #
 # Exits 77 (ctest: skipped) only when scripts/fetch-real-speech.sh cannot fetch the packages
@@ -31,6 +32,7 @@ failed=0
 align=()
 [ -n "${REPLAY_ALIGN:-}" ] && align=(--align)
 [ -n "${REPLAY_ADAPT:-}" ] && align+=(--adapt-speaker)
+[ -n "${REPLAY_FOLLOW:-}" ] && align+=(--follow-lag "$REPLAY_FOLLOW")
 [ ${#align[@]} -gt 0 ] && align+=(--voice festvox-ru-nsh=ru)
 # Calibrates SPEAKER on its first REPLAY_CALIBRATE files into $out/calibrated/SPEAKER.json and
 # links the rest into $out/calibrated/SPEAKER-rest/SPEAKER/.
@@ -56,7 +58,7 @@ for pair in "$@"; do
     calibrate "$speaker" || { failed=1; continue; }
     corpus="$out/calibrated/$speaker-rest" templates="$out/calibrated/$speaker.json"
   fi
-  echo "== $speaker, templates $templates${REPLAY_ALIGN:+, aligned on its words}${REPLAY_ADAPT:+, the voice carried from file to file} (floors: visual groups $group, jaw r from audio $jaw," \
+  echo "== $speaker, templates $templates${REPLAY_ALIGN:+, aligned on its words}${REPLAY_ADAPT:+, the voice carried from file to file}${REPLAY_FOLLOW:+, followed $REPLAY_FOLLOW s behind} (floors: visual groups $group, jaw r from audio $jaw," \
     "closures caught ${closures:-0}, false closures at most ${falseClosures:-1})"
   "$lipsync" eval --corpus "$corpus" --no-per-file --templates "$templates" "${align[@]}" \
     --min-group-accuracy "$group" \

@@ -9,15 +9,6 @@
 namespace lipsyncd::test {
 namespace {
 
-struct Shipped {
-    lipsync::PoseSet poses = lipsync::PoseSet::named("facefx");
-    lipsync::BigramCurveSet curves = lipsync::BigramCurveSet::named("english", poses);
-};
-const Shipped& shipped() {
-    static const Shipped s;
-    return s;
-}
-
 // Random classes and durations from 5 ms to 400 ms, starting at `start`.
 PhonemeSchedule randomSchedule(std::mt19937& rng, std::size_t n, double start = 0) {
     const auto& set = PhonemeSet::common();

@@ -16,6 +16,16 @@ inline lipsync::ControlCurve flat(float v) {
     return lipsync::ControlCurve({{0, v}, {1, v}});
 }
 
+// The shipped pose set and curve set (facefx, english), loaded once.
+struct Shipped {
+    lipsync::PoseSet poses = lipsync::PoseSet::named("facefx");
+    lipsync::BigramCurveSet curves = lipsync::BigramCurveSet::named("english", poses);
+};
+inline const Shipped& shipped() {
+    static const Shipped s;
+    return s;
+}
+
 inline std::size_t cls(const std::string& name) {
     return *PhonemeSet::common().find(name);
 }

@@ -99,6 +99,14 @@ std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::
     return script;
 }
 
+std::vector<dsp::ScriptWord> scriptForVoice(EspeakSynthesizer& synth, const std::string& text,
+                                            const std::string& voice,
+                                            std::vector<std::string>* warnings, bool reductions) {
+    const auto map = espeakMapForVoice(voice);
+    const auto weakForms = reductions ? Reductions::forVoice(voice, map) : Reductions{};
+    return scriptForText(synth, text, voice, map, warnings, &weakForms);
+}
+
 dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::path& audio,
                                const std::string& text, const std::string& voice,
                                const dsp::TemplateSet& templates,
@@ -106,13 +114,26 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
                                const dsp::AlignerConfig& aligner, const dsp::DecodeOptions& decode,
                                const std::optional<dsp::RawFormat>& raw, bool reductions,
                                dsp::SpeakerAdaptation* speaker) {
-    const auto map = espeakMapForVoice(voice);
-    const auto& set = PhonemeSet::named(map.phonemeSet());
     std::vector<std::string> warnings;
-    const auto weakForms = reductions ? Reductions::forVoice(voice, map) : Reductions{};
-    const auto script = scriptForText(synth, text, voice, map, &warnings, &weakForms);
+    const auto script = scriptForVoice(synth, text, voice, &warnings, reductions);
+    const auto& set = PhonemeSet::named(espeakMapForVoice(voice).phonemeSet());
     auto result =
         dsp::alignFile(audio, script, templates, set, frontEnd, aligner, decode, raw, speaker);
+    result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
+    return result;
+}
+
+dsp::AnalysisResult followText(EspeakSynthesizer& synth, const std::filesystem::path& audio,
+                               const std::string& text, const std::string& voice,
+                               const dsp::TemplateSet& templates, double lagSeconds,
+                               const dsp::FrontEndConfig& frontEnd,
+                               const dsp::AlignerConfig& aligner, const dsp::DecodeOptions& decode,
+                               bool reductions) {
+    std::vector<std::string> warnings;
+    const auto script = scriptForVoice(synth, text, voice, &warnings, reductions);
+    const auto& set = PhonemeSet::named(espeakMapForVoice(voice).phonemeSet());
+    auto result =
+        dsp::followFile(audio, script, templates, set, lagSeconds, frontEnd, aligner, decode);
     result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
     return result;
 }

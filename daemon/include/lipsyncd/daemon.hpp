@@ -33,7 +33,10 @@
 
 namespace lipsyncd {
 class EspeakSynthesizer;
+namespace dsp {
+struct ScriptWord;
 }
+}  // namespace lipsyncd
 
 namespace lipsyncd::daemon {
 
@@ -59,6 +62,10 @@ struct DaemonConfig {
     // [live]
     std::string captureDevice = "default";  // an ALSA capture device, or "file:PATH.wav" (tests)
     int captureRate = 16000;
+    // A line cued with its words (`line`) drives the mouth from its words, decided this far
+    // behind the sound (dsp::LineFollower); off: from the audio alone, with the least delay.
+    bool followLines = true;
+    double followLagSeconds = 0.1;
     // [control]
     std::filesystem::path socket = "/run/lipsyncd/control.sock";
     unsigned socketMode = 0660;
@@ -181,6 +188,9 @@ class ClipMaker {
         bool learnt = false;
         std::string detail;  // how many words were placed, or why nothing was learnt
     };
+    // A line's words as live input follows them (Live::follow): read by espeak-ng in the
+    // config's voice. InputError when they cannot be (no word it reads, another phoneme set).
+    std::vector<dsp::ScriptWord> readLine(const std::string& text, EspeakSynthesizer& synth) const;
     LineLesson learnFromLine(std::span<const float> samples, int rate, const std::string& text,
                              EspeakSynthesizer& synth,
                              const std::function<void(const std::string&)>& log = {}) const;
@@ -201,7 +211,16 @@ class ClipMaker::Live {
     virtual ~Live() = default;
     // Feeds captured samples; appends the weight frames that became final to `out`.
     virtual void push(std::span<const float> samples, PoseTrack& out) = 0;
-    virtual double latencySeconds() const = 0;  // the front end's reported bound
+    // The front end's reported bound (a followed line's, while one is followed).
+    virtual double latencySeconds() const = 0;
+    // A line with known words (`line`): its cue (the frames from here on wait for its words),
+    // its words once read (true: the mouth follows them from the cue on, [live] follow_lag
+    // behind; false: the line was over first), and its end (back to the audio alone). Frames
+    // that become final meanwhile go to `out`.
+    virtual void cue(PoseTrack& out) = 0;
+    virtual bool follow(std::span<const dsp::ScriptWord> words, PoseTrack& out) = 0;
+    virtual void endLine(PoseTrack& out) = 0;
+    virtual bool following() const = 0;
 };
 
 class Daemon {

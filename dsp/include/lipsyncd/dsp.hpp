@@ -14,9 +14,11 @@
 //   analyzeFile()       the whole chain over a file, for the command line and tests.
 //   ForcedAligner       known words: Viterbi alignment of their phonemes on the classifier's
 //                       per-frame distances, in bounded memory (alignFile() over a file).
+//   LineFollower        known words heard as they are said: a fixed-lag forced alignment
+//                       (the service's live lines; followFile() over a file).
 //
-// Real-time paths (StreamingAnalyzer::push and everything under it) do not allocate once
-// constructed, except for the segments handed out.
+// Real-time paths (StreamingAnalyzer::push, LineFollower::push and everything under them) do
+// not allocate once constructed, except for the segments handed out.
 #pragma once
 
 #include <array>
@@ -626,6 +628,9 @@ class StreamingAnalyzer {
 
     // Any block size. Sinks are called from inside.
     void push(std::span<const float> samples);
+    // All of a decoder's input, in blocks (a file's whole analysis: then finish()); returns how
+    // many samples were read.
+    std::int64_t pushAll(AudioDecoder& decoder);
     void finish();
     // From a sound entering push() to the segment that covers it closing: resampler delay, a
     // window, the decoder's lag and the segmenter's hold.
@@ -1077,6 +1082,14 @@ class ForcedAligner {
     // no way through them at the end.
     void expectFrames(std::int64_t total);
     Alignment finish();
+    // Following a line as it is said (LineFollower), before the first push(): the path is
+    // not kept (finish() then places no word) and the room for the windows of the config's
+    // lookaheadSeconds and commitSeconds is reserved now, so push() never allocates.
+    void followOnly();
+    // The phoneme (index into the set) the best partial path so far held `lagFrames` frames
+    // before the newest (at most lookaheadSeconds back); a pause between words is silence;
+    // -1 in a stretch no word explains (a filler) and before the first frame.
+    int phonemeBack(int lagFrames) const;
     // The shortest audio the script fits in (minimum durations), seconds.
     double minimumSeconds() const;
     // Largest number of frames of back-pointers held at once (the memory bound, for tests).
@@ -1124,5 +1137,63 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
                           const DecodeOptions& decode = {},
                           const std::optional<RawFormat>& raw = std::nullopt,
                           SpeakerAdaptation* speaker = nullptr);
+
+// A line whose words are known, followed as it is said (the service's live lines after a cue):
+// a fixed-lag forced alignment. Each frame's class is the one the best partial path held `lag`
+// frames after it (ForcedAligner::phonemeBack); where no word explains the sound (a cough, an
+// added word) it is the front end's own class for the frame. The speaking rate is unknown while
+// the line is said: the synthesiser's durations are taken as they are (time scale 1).
+class LineFollower {
+  public:
+    using SegmentSink = std::function<void(const PhonemeSegment&)>;
+    // The window is committed every kCommitSeconds (AlignerConfig::lookaheadSeconds still
+    // bounds how far back a path may change): the room reserved for it stays small.
+    static constexpr double kCommitSeconds = 1.0;
+    // `lagSeconds`: from 0 to the config's lookaheadSeconds.
+    LineFollower(std::span<const ScriptWord> script, const PhonemeSet& set, double hopSeconds,
+                 double lagSeconds, const AlignerConfig& config = {});
+    // Each segment as it closes (the set's names; frames cover their hop around their time).
+    void onSegment(SegmentSink sink) { sink_ = std::move(sink); }
+    // One frame of the front end, from inside StreamingAnalyzer's frame sink: its label,
+    // templateDistances() and distances(). Allocates nothing.
+    void push(const FrameLabel& label, std::span<const float> templateDistances,
+              std::span<const float> distances);
+    // The phoneme of the segment still open (-1: none yet) and the end of its newest frame.
+    int openPhoneme() const { return open_.phoneme; }
+    double openUntil() const { return open_.end; }
+    // The line is over: the frames held back go to the best path's ends, and the open segment
+    // closes.
+    void finish();
+    int lagFrames() const { return lag_; }
+
+  private:
+    struct Held {
+        double time = 0;
+        int heard = 0;  // the front end's own class
+    };
+    void place(const Held& frame, int phoneme);
+
+    const PhonemeSet* set_;
+    ForcedAligner aligner_;
+    double hop_;
+    int lag_;
+    float share_;
+    std::vector<float> term_, mixed_;
+    std::vector<Held> held_;  // the last lag_ + 1 frames, a ring
+    std::int64_t frames_ = 0;
+    struct Open {
+        int phoneme = -1;
+        double start = 0, end = 0;
+    } open_;
+    SegmentSink sink_;
+};
+
+// A file followed as a live line is (LineFollower over the streaming front end), for `lipsync
+// eval --follow-lag`: the schedule and the levels (heard jaw at the audio-only share) the
+// service's live mouth takes from a line with its words.
+AnalysisResult followFile(const std::filesystem::path& file, std::span<const ScriptWord> script,
+                          const TemplateSet& templates, const PhonemeSet& set, double lagSeconds,
+                          const FrontEndConfig& config = {}, const AlignerConfig& aligner = {},
+                          const DecodeOptions& decode = {});
 
 }  // namespace lipsyncd::dsp

@@ -212,6 +212,15 @@ void applyConstraints(const PoseSet& poses, PoseCurves& curves, std::size_t from
 // never re-breaks a constraint (2.2.3).
 void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const float> previous,
                 PoseCurves& curves, std::size_t fromFrame = 0);
+// What limitSpeed works in, for a caller that runs it every tick (the streaming runtime): kept
+// between calls, so a call allocates nothing. Built for one pose set.
+struct SpeedLimitScratch {
+    explicit SpeedLimitScratch(const PoseSet& poses);
+    std::vector<std::size_t> order;  // the poses as placed: highest priority first
+    std::vector<float> prev, now;    // one frame each
+};
+void limitSpeed(const PoseSet& poses, bool keepConstraints, std::span<const float> previous,
+                PoseCurves& curves, std::size_t fromFrame, SpeedLimitScratch& scratch);
 
 // Silences at least rest.minPause long, and a silence that opens or closes the schedule (where
 // `bracket` says it starts or ends there): every pose is scaled by a ramp that reaches 0
@@ -282,6 +291,9 @@ PoseTrack animateFilter(std::span<const PhonemeSegment> schedule, const BigramCu
 // delay = 0 is the causal mode: the next phoneme is unknown, so frames up to the last closed
 // boundary are computed against an estimate (the current phoneme continued, for its mean
 // duration so far) and go out at once.
+// It runs on the live path (a push or preview every 10 ms): once its buffers have grown to the
+// longest window seen (reserved up front for a few seconds), push() and preview() allocate
+// nothing.
 class StreamingRuntime {
   public:
     StreamingRuntime(const BigramCurveSet& set, const PoseSet& poses, double delaySeconds,
@@ -298,6 +310,8 @@ class StreamingRuntime {
 
   private:
     void emitUntil(double until, bool final, PoseTrack& out, const PhonemeSegment* open = nullptr);
+    void buildSchedule(bool causal, const PhonemeSegment* open);
+    void resetCurves(std::size_t firstFrame, std::size_t frames);
     void dropOldSegments();
     double longestWindow() const;
 
@@ -312,6 +326,10 @@ class StreamingRuntime {
     double origin_ = 0;        // time of frame 0: the first segment's start
     std::size_t emitted_ = 0;  // frames already out
     std::vector<float> last_;  // the last frame out
+    // Each emitUntil's working state, kept so that it reuses their memory instead of allocating.
+    std::vector<PhonemeSegment> schedule_;  // window_, plus the causal mode's estimate
+    PoseCurves curves_;
+    SpeedLimitScratch speed_;
 };
 
 // ---------------------------------------------------------------------------------------------

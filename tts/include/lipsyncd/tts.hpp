@@ -104,6 +104,13 @@ std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::
                                            std::vector<std::string>* warnings,
                                            const Reductions* reductions = nullptr);
 
+// scriptForText with the voice's own phoneme map (espeakMapForVoice) and, with `reductions`,
+// its language's common reductions: what alignText, followText and the service's live lines read.
+std::vector<dsp::ScriptWord> scriptForVoice(EspeakSynthesizer& synth, const std::string& text,
+                                            const std::string& voice,
+                                            std::vector<std::string>* warnings,
+                                            bool reductions = true);
+
 // Aligns `text` on the speech in `audio` with the voice's phoneme map and the given front end;
 // the result says which words were placed and where the audio-only analysis stands in.
 // `reductions`: try the language's common reductions too (Reductions::forVoice). `speaker`: one
@@ -116,6 +123,15 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
                                const dsp::DecodeOptions& decode = {},
                                const std::optional<dsp::RawFormat>& raw = std::nullopt,
                                bool reductions = true, dsp::SpeakerAdaptation* speaker = nullptr);
+
+// Follows `text` in `audio` as the service follows a live line with its words (dsp::followFile:
+// a fixed-lag alignment, `lagSeconds` behind the newest frame).
+dsp::AnalysisResult followText(EspeakSynthesizer& synth, const std::filesystem::path& audio,
+                               const std::string& text, const std::string& voice,
+                               const dsp::TemplateSet& templates, double lagSeconds,
+                               const dsp::FrontEndConfig& frontEnd = {},
+                               const dsp::AlignerConfig& aligner = {},
+                               const dsp::DecodeOptions& decode = {}, bool reductions = true);
 
 // The schedule of an audio file about to be played: aligned on `text` when given, else on the
 // words of a `FILE.txt` beside `FILE.wav` when there is one, else the audio-only analysis. Text
