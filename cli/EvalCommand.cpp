@@ -527,7 +527,7 @@ void addEvalCommand(CLI::App& app) {
                     "--align), 0..1, rise above this")
         ->check(CLI::Range(0.0, 1.0));
     cmd->add_flag("!--no-per-file", o->perFile, "Leave out the per-file table");
-    cmd->add_flag("--align", o->align,
+    auto* align = cmd->add_flag("--align", o->align,
                   "Score 'lipsync align' instead: each NAME.wav aligned on the words of NAME.txt "
                   "beside it (files without one are skipped); the jaw 'audio' column is then "
                   "the aligned schedule's, and each speaker's boundaries are timed against the "
@@ -535,12 +535,13 @@ void addEvalCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voices,
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");
-    addNumberOption(*cmd, "--follow-lag", o->followLag,
+    cmd->add_option("--follow-lag", o->followLag,
                     "With --align: follow each file as the service follows a live line said "
                     "after its cue (`lipsync ctl line`), each frame's class decided this many "
                     "seconds after it (a fixed-lag alignment at the speed the voice reads the "
-                    "words), instead of aligning the whole file",
-                    0.0, dsp::AlignerConfig{}.lookaheadSeconds);
+                    "words), instead of aligning the whole file")
+        ->check(CLI::Range(0.0, dsp::AlignerConfig{}.lookaheadSeconds))
+        ->needs(align);
     o->aligner.addTo(*cmd, "With --align");
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "

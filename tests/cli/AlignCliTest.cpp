@@ -63,6 +63,24 @@ TEST(AlignCli, EvalAlignScoresTheAlignedWordsPerSpeakerAndVoice) {
     }
 }
 
+// `--follow-lag`: each file followed as lipsyncd follows a live line with its words; the
+// report says so and names the lag, and the option means nothing without --align.
+TEST(AlignCli, EvalFollowLagScoresLinesAsTheServiceFollowsThem) {
+    const auto dir = scratchDir("cli_eval_follow");
+    const std::string en = "Seven puppets sang a song about the moon.";
+    speak(dir / "anna", "line", en, "en-us+f3", en);
+    const auto r = runLipsync({"eval", "--corpus", dir.string(), "--align", "--follow-lag", "0.1",
+                               "--json", "-", "--no-per-file"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("(followed on the words, lag 100 ms)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("r 0."), std::string::npos) << r.out;
+    const auto json = nlohmann::json::parse(r.out.substr(r.out.find("\n{") + 1));
+    EXPECT_GT(json["speakers"]["anna"]["group_accuracy"].get<double>(), 0.8);
+    const auto alone = runLipsync({"eval", "--corpus", dir.string(), "--follow-lag", "0.1"});
+    EXPECT_EQ(alone.exitCode, 2);
+    EXPECT_NE(alone.err.find("--follow-lag requires --align"), std::string::npos) << alone.err;
+}
+
 TEST(AlignCli, EvalAlignWithoutAnyWordsFileSaysSo) {
     const auto dir = scratchDir("cli_eval_align_none");
     speak(dir, "line", "Open wide.", "en-us", "");
