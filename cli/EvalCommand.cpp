@@ -2,6 +2,7 @@
 // puppet's jaw follows the speech, per file and per speaker (the worst speaker is the figure).
 #include <iomanip>
 #include <iostream>
+#include <lipsyncd/daemon.hpp>
 #include <lipsyncd/dsp.hpp>
 #include <lipsyncd/tts.hpp>
 #include <map>
@@ -38,6 +39,8 @@ struct EvalOptions {
     // --follow-lag: with --align, each file followed as the service follows a live line with
     // its words (a fixed-lag alignment this many seconds behind; negative: aligned whole).
     double followLag = -1;
+    // --live: each file through the service's live path (ClipMaker::Live) instead.
+    bool live = false;
     AlignerOptions aligner;
     std::vector<std::string> voices;
     FrontEndOptions frontEnd;
@@ -78,6 +81,8 @@ struct Evaluator {
     std::unique_ptr<EspeakSynthesizer> synth;  // --align, --adapt-speaker: reads the words
     // --adapt-speaker: each speaker's voice so far, carried from file to file.
     mutable std::map<std::string, dsp::SpeakerAdaptation> speakers;
+    // --live: each speaker's service pieces (its show voice, with --adapt-speaker).
+    mutable std::map<std::string, std::unique_ptr<daemon::ClipMaker>> liveMakers;
 
     explicit Evaluator(const EvalOptions& options) : o(options) {
         if (o.jaw) puppet.emplace(output::Puppet::named(o.puppet), o.jawActuator);
@@ -100,8 +105,9 @@ struct Evaluator {
         return track;
     }
 
+    // `mouth`: the weights under test (the runtime over the schedule, or the live path's).
     JawScores scoreJaws(const CorpusItem& item, const PhonemeSchedule& reference,
-                        const PhonemeSchedule& schedule, const LevelTrack& levels) const {
+                        const PoseTrack& mouth, const LevelTrack& levels) const {
         const auto frames = static_cast<std::size_t>(reference.back().end * kFrameRate) + 1;
         const auto truth = lipsync::jawReference(reference, set, kFrameRate, frames);
         const auto score = [&](const PoseTrack& track) {
@@ -114,10 +120,10 @@ struct Evaluator {
         const auto heard = dsp::measureLevels(audio.samples, audio.sampleRate, kFrameRate);
         // The labels' jaw is the exact phonemes' (as `say` gives it): not what the audio was
         // heard to say.
-        auto loudnessOnly = levels;
+        auto loudnessOnly = o.live ? heard : levels;
         loudnessOnly.jaw.clear();
-        return {score(runtime.animate(schedule, &levels)),
-                score(runtime.animate(reference, &loudnessOnly)), score(envelopeTrack(heard))};
+        return {score(mouth), score(runtime.animate(reference, &loudnessOnly)),
+                score(envelopeTrack(heard))};
     }
 
     // The voice whose reading of the words a speaker's files are aligned with.
@@ -207,6 +213,60 @@ struct Evaluator {
         }
     }
 
+    // --live: the service's pieces for a speaker, as lipsyncd's config makes them: the
+    // templates and runtime given, the speaker's voice reading the words, and with
+    // --adapt-speaker a show voice of its own.
+    daemon::ClipMaker& liveMaker(const std::string& speaker) const {
+        auto& maker = liveMakers[speaker];
+        if (maker) return *maker;
+        daemon::DaemonConfig c;
+        c.hardware = false;
+        c.templates = o.frontEnd.templates;
+        c.runtime = o.runtime.spec;
+        c.voice = voiceFor(speaker);
+        c.adaptSpeaker = o.adaptSpeaker;
+        c.followLines = o.align;
+        if (o.followLag >= 0) c.followLagSeconds = o.followLag;
+        maker = std::make_unique<daemon::ClipMaker>(c);
+        return *maker;
+    }
+
+    // --live: the file as a microphone brings it to the service, 10 ms at a time. With
+    // --align it is cued with its words and followed; with --adapt-speaker the show voice learns
+    // the line afterwards, as the service does once the next cue ends it. Returns the phonemes
+    // the runtime took and the mouth it made.
+    std::pair<PhonemeSchedule, PoseTrack> live(const CorpusItem& item) const {
+        auto& maker = liveMaker(item.speaker);
+        auto audio = dsp::readAudioFile(item.audio, o.frontEnd.decode());
+        const auto seconds = static_cast<double>(audio.samples.size()) / audio.sampleRate;
+        const auto words = wordsBeside(item.audio);
+        const auto text = words ? readTextFile(*words) : std::string();
+        auto path = maker.startLive(audio.sampleRate);
+        PhonemeSchedule heard;
+        path->watch([&](const PhonemeSegment& s) { heard.push_back(s); });
+        PoseTrack mouth;
+        mouth.poses = maker.poseNames();
+        if (o.align && words) {
+            path->cue(mouth);
+            try {
+                path->follow(maker.readLine(text, *synth), mouth);
+            } catch (const InputError& e) {
+                std::cerr << "lipsync eval: " << item.speaker << '/' << item.name
+                          << ": words not followed: " << e.what() << '\n';
+            }
+        }
+        const auto block = static_cast<std::size_t>(audio.sampleRate / 100);
+        for (std::size_t at = 0; at < audio.samples.size(); at += block)
+            path->push(std::span<const float>(audio.samples)
+                           .subspan(at, std::min(block, audio.samples.size() - at)),
+                       mouth);
+        path->finish(mouth);
+        if (!heard.empty()) heard.back().end = seconds;
+        if (o.adaptSpeaker && words)
+            maker.learnFromLine(audio.samples, audio.sampleRate, text, *synth);
+        return {std::move(heard), std::move(mouth)};
+    }
+
     // --schedules: the schedule scored, where `lipsync analyze -s` (or align) would write it.
     void keepSchedule(const CorpusItem& item, const PhonemeSchedule& hypothesis) const {
         const auto dir = std::filesystem::path(o.schedules) / item.speaker;
@@ -218,12 +278,21 @@ struct Evaluator {
 
     Score scoreFile(const CorpusItem& item) const {
         const auto reference = readLabels(item.labels, o.labels);
-        const auto [hypothesis, levels] = schedule(item);
+        PhonemeSchedule hypothesis;
+        LevelTrack levels;
+        PoseTrack mouth;
+        if (o.live)
+            std::tie(hypothesis, mouth) = live(item);
+        else
+            std::tie(hypothesis, levels) = schedule(item);
         if (!o.schedules.empty()) keepSchedule(item, hypothesis);
         Score s;
         s.schedule = dsp::scoreSchedule(hypothesis, reference, set);
         if (o.align) s.boundaries = dsp::scoreBoundaries(hypothesis, reference);
-        if (puppet && !reference.empty()) s.jaw = scoreJaws(item, reference, hypothesis, levels);
+        if (puppet && !reference.empty()) {
+            if (!o.live) mouth = runtime.animate(hypothesis, &levels);
+            s.jaw = scoreJaws(item, reference, mouth, levels);
+        }
         return s;
     }
 };
@@ -376,10 +445,14 @@ std::pair<std::string, double> worst(const Report& report, F figure) {
 
 void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
                  const EvalOptions& o) {
-    const bool followed = o.followLag >= 0;
+    // Live, the words are followed (at the service's lag unless given), never aligned whole.
+    const bool followed = o.followLag >= 0 || o.live;
+    const double lagSeconds =
+        o.followLag >= 0 ? o.followLag : daemon::DaemonConfig{}.followLagSeconds;
     const std::string made = followed ? " followed" : " aligned";
     const std::string lag =
-        followed ? ", lag " + std::to_string(std::lround(o.followLag * 1000)) + " ms" : "";
+        (followed ? ", lag " + std::to_string(std::lround(lagSeconds * 1000)) + " ms" : "") +
+        (o.live ? ", live path" : "");
     if (o.perFile) {
         printHeader(out, "file", o.jaw);
         for (const auto& f : report.files) printRow(out, f.speaker + "/" + f.name, f.score, o.jaw);
@@ -402,10 +475,11 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
         const auto audio = worst(report, [](const Score& s) { return s.jaw.audio.r(); });
         const auto labels = worst(report, [](const Score& s) { return s.jaw.labels.r(); });
         out << "jaw through '" << o.puppet << "': r " << fixed2(report.total.jaw.audio.r())
-            << (o.align ? made : " from audio") << " (worst speaker " << audio.first << ' '
-            << fixed2(audio.second) << "), " << fixed2(report.total.jaw.labels.r())
-            << " from the labels (worst " << labels.first << ' ' << fixed2(labels.second)
-            << "), envelope follower " << fixed2(report.total.jaw.envelope.r()) << '\n';
+            << (o.align ? made : " from audio") << (o.live ? " live" : "") << " (worst speaker "
+            << audio.first << ' ' << fixed2(audio.second) << "), "
+            << fixed2(report.total.jaw.labels.r()) << " from the labels (worst " << labels.first
+            << ' ' << fixed2(labels.second) << "), envelope follower "
+            << fixed2(report.total.jaw.envelope.r()) << '\n';
     }
 }
 
@@ -542,6 +616,14 @@ void addEvalCommand(CLI::App& app) {
                     "words), instead of aligning the whole file")
         ->check(CLI::Range(0.0, dsp::AlignerConfig{}.lookaheadSeconds))
         ->needs(align);
+    cmd->add_flag("--live", o->live,
+                  "Score the service's live path instead: each file fed to lipsyncd's live input "
+                  "10 ms at a time (its front end, the runtime in its causal mode, the heard jaw "
+                  "and loudness as live), the schedule being what the runtime took; with --align "
+                  "each file is cued with its words and followed (at --follow-lag, default "
+                  "[live] follow_lag), with --adapt-speaker the service's show voice learns "
+                  "each line after it. Takes --templates and the runtime options; the front end "
+                  "runs as lipsyncd runs it");
     o->aligner.addTo(*cmd, "With --align");
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "

@@ -56,6 +56,7 @@ void StreamingLive::feed(PhonemeSegment segment) {
     if (segment.end <= fedUntil_) return;
     if (fedUntil_ >= 0) segment.start = fedUntil_;
     fedUntil_ = segment.end;
+    if (watch_) watch_(segment);
     runtime_.push(segment, *out_);
 }
 
@@ -100,6 +101,13 @@ void StreamingLive::endLine(PoseTrack& out) {
     out_ = &out;
     follower_->finish();  // the frames held back go to the runtime
     follower_.reset();
+}
+
+void StreamingLive::finish(PoseTrack& out) {
+    endLine(out);
+    out_ = &out;
+    analyzer_.finish();
+    runtime_.finish(out);
 }
 
 // Each new weight frame takes the jaw heard around its time (the audio frames within 20 ms,

@@ -30,7 +30,11 @@ class StreamingLive : public ClipMaker::Live {
     void cue(PoseTrack& out) override;
     bool follow(std::span<const dsp::ScriptWord> words, PoseTrack& out) override;
     void endLine(PoseTrack& out) override;
+    void finish(PoseTrack& out) override;
     bool following() const override { return follower_.has_value(); }
+    void watch(std::function<void(const PhonemeSegment&)> sink) override {
+        watch_ = std::move(sink);
+    }
 
     // A line's words may come this long after its cue (the worker reads them with espeak-ng):
     // the frames since the cue wait for them, in room reserved at the start.
@@ -68,6 +72,7 @@ class StreamingLive : public ClipMaker::Live {
     std::vector<float> heldDistances_;  // [frame][templates, full][class]
     std::size_t held_ = 0;              // frames held since the cue (the ring keeps the newest)
     std::optional<dsp::LineFollower> follower_;
+    std::function<void(const PhonemeSegment&)> watch_;
 };
 
 }  // namespace lipsyncd::daemon

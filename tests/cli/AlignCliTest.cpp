@@ -81,6 +81,31 @@ TEST(AlignCli, EvalFollowLagScoresLinesAsTheServiceFollowsThem) {
     EXPECT_NE(alone.err.find("--follow-lag requires --align"), std::string::npos) << alone.err;
 }
 
+// `--live`: the files through lipsyncd's live path, scored as the runtime took them; cued with
+// their words (--align), the phonemes come from following them and score better.
+TEST(AlignCli, EvalLiveScoresTheServicesLivePath) {
+    const auto dir = scratchDir("cli_eval_live");
+    const std::string en = "Seven puppets sang a song about the moon.";
+    speak(dir / "anna", "line", en, "en-us+f3", en);
+    const auto audio = runLipsync({"eval", "--corpus", dir.string(), "--live", "--json", "-"});
+    ASSERT_EQ(audio.exitCode, 0) << audio.err;
+    EXPECT_NE(audio.out.find("from audio live"), std::string::npos) << audio.out;
+    const auto followed = runLipsync(
+        {"eval", "--corpus", dir.string(), "--live", "--align", "--json", "-", "--no-per-file"});
+    ASSERT_EQ(followed.exitCode, 0) << followed.err;
+    EXPECT_NE(followed.out.find("(followed on the words, lag 100 ms, live path)"),
+              std::string::npos)
+        << followed.out;
+    const auto score = [](const std::string& out) {
+        return nlohmann::json::parse(out.substr(out.find("\n{") + 1))["speakers"]["anna"];
+    };
+    const auto a = score(audio.out), f = score(followed.out);
+    // The schedule the runtime took covers the line as the offline analysis's does.
+    EXPECT_GT(a["group_accuracy"].get<double>(), 0.6);
+    EXPECT_GT(f["group_accuracy"].get<double>(), a["group_accuracy"].get<double>() + 0.05);
+    EXPECT_GT(f["jaw"]["audio"]["r"].get<double>(), 0.7);
+}
+
 TEST(AlignCli, EvalAlignWithoutAnyWordsFileSaysSo) {
     const auto dir = scratchDir("cli_eval_align_none");
     speak(dir, "line", "Open wide.", "en-us", "");

@@ -221,6 +221,10 @@ class ClipMaker::Live {
     virtual bool follow(std::span<const dsp::ScriptWord> words, PoseTrack& out) = 0;
     virtual void endLine(PoseTrack& out) = 0;
     virtual bool following() const = 0;
+    // Each phoneme as the runtime takes it (`lipsync eval --live` scores them); before pushing.
+    virtual void watch(std::function<void(const PhonemeSegment&)> sink) = 0;
+    // The input is over (a file, never a microphone): the phonemes still open are taken too.
+    virtual void finish(PoseTrack& out) = 0;
 };
 
 class Daemon {
