@@ -1,15 +1,15 @@
 // A line followed as it is said: the forced aligner in its following form (no path kept, its
 // room reserved), read a fixed lag behind the newest frame. The Viterbi path is traced back
 // from the last frame once the input is over (Rabiner 1989, section III.B); a live mouth cannot
-// wait for that, so each frame takes the state the best partial path held `lag` frames back, a
-// decision that later frames can no longer change and that is rarely changed past a tenth of a
-// second (docs/measurements.md, "Live lines followed on their words"). The frames the lag holds
-// back wait in a ring with the front end's own class, which stands where no word explains the
-// sound.
+// wait for that, so each frame takes the state the best partial path held `lag` frames after it.
+// Later frames may still move the best path there, but less often the longer the lag: the lag
+// trades delay for sureness (docs/measurements.md, "Live lines followed on their words"). The
+// frames the lag holds back wait in a ring with the front end's own class, which stands where
+// no word explains the sound.
 #include <algorithm>
 #include <cmath>
 #include <lipsyncd/dsp.hpp>
-#include <stdexcept>
+#include <string>
 
 #include "AlignerInput.hpp"
 
