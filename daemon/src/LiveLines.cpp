@@ -93,11 +93,16 @@ json Daemon::Impl::learnLine(std::optional<LiveLine> over) {
 void Daemon::Impl::followLine() {
     auto read = queue.takeWordsRead();
     if (!read || !live || !live->line() || live->line()->cue != read->cue) return;
-    const auto name = "live line " + shownLine(live->line()->text);
-    if (!read->error.empty())
+    const auto& text = live->line()->text;
+    const auto name = "live line " + shownLine(text);
+    if (!read->error.empty()) {
         logWarning(name + ": the mouth follows the audio alone: " + read->error);
-    else if (live->follow(read->cue, read->words))
+        control->broadcast(json{{"event", "following"}, {"text", text}, {"error", read->error}});
+    } else if (live->follow(read->cue, read->words)) {
         logInfo(name + ": the mouth follows its " + std::to_string(read->words.size()) + " words");
+        control->broadcast(
+            json{{"event", "following"}, {"text", text}, {"words", read->words.size()}});
+    }
 }
 
 void Daemon::Impl::reportLines() {

@@ -220,8 +220,18 @@ TEST(LiveLine, WithoutAdaptSpeakerALineIsFollowedOnlyAndWithoutEitherRefused) {
     Client cf(f.socket());
     ASSERT_TRUE(cf.connected());
     ASSERT_TRUE(cf.request({{"cmd", "live"}, {"on", true}})["ok"]);
+    Client watcher(f.socket());
+    ASSERT_TRUE(watcher.request({{"cmd", "subscribe"}})["ok"]);
     const auto followed = cf.request({{"cmd", "line"}, {"text", kHelloWords}});
     EXPECT_TRUE(followed["ok"]) << followed.dump();
+    // Subscribers hear when the mouth starts following the words.
+    json event = json::object();
+    for (int i = 0; i < 500 && event.value("event", "") != "following"; ++i) {
+        event = json::parse(watcher.readLine(), nullptr, false);
+        if (!event.is_object()) event = json::object();
+    }
+    EXPECT_EQ(event.value("words", 0), 17) << event.dump();
+    EXPECT_EQ(event.value("text", ""), kHelloWords) << event.dump();
     json line = json::object();
     for (int i = 0; i < 100 && !line.value("following", false); ++i) {
         std::this_thread::sleep_for(50ms);
