@@ -43,8 +43,12 @@ void StreamingLive::push(std::span<const float> samples, PoseTrack& out) {
     analyzer_.push(samples);
     // The phoneme still open: the followed line's, or the newest frame's class.
     if (follower_ && follower_->openPhoneme() >= 0) {
-        if (follower_->openUntil() > fedUntil_)
+        if (follower_->openUntil() > fedUntil_) {
+            if (follower_->upcomingPhoneme() >= 0)
+                runtime_.expect(className(follower_->upcomingPhoneme()),
+                                follower_->upcomingStart());
             runtime_.preview(className(follower_->openPhoneme()), follower_->openUntil(), out);
+        }
     } else if (!follower_ && !openPhoneme_.empty() && openUntil_ > fedUntil_) {
         runtime_.preview(openPhoneme_, openUntil_, out);
     }
@@ -57,6 +61,9 @@ void StreamingLive::feed(PhonemeSegment segment) {
     if (fedUntil_ >= 0) segment.start = fedUntil_;
     fedUntil_ = segment.end;
     if (watch_) watch_(segment);
+    // Following a line, what comes after the closed phoneme is known: the one open now.
+    if (follower_ && follower_->openPhoneme() >= 0)
+        runtime_.expect(className(follower_->openPhoneme()), segment.end);
     runtime_.push(segment, *out_);
 }
 

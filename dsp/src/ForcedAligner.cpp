@@ -5,7 +5,8 @@
 // part older than lookaheadSeconds becomes final; paths that disagree with it there are
 // dropped, so what was committed is never contradicted later. Following a line as it is said
 // (followOnly, LineFollower), nothing of the path is kept: the windows only bound the memory,
-// which is reserved up front, and phonemeBack() reads the best partial path a fixed lag back.
+// which is reserved up front, and phonemesBack() reads the best partial path back from the
+// newest frame.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -335,16 +336,19 @@ void ForcedAligner::followOnly() {
     s.traced.reserve(nodes);
 }
 
-int ForcedAligner::phonemeBack(int lagFrames) const {
+void ForcedAligner::phonemesBack(std::span<int> out) const {
     const auto& s = *state_;
-    if (s.frames == 0) return -1;
-    const std::int64_t last = s.frames - 1;
-    const std::int64_t at = std::max(s.windowStart, last - std::max(0, lagFrames));
-    const int node = s.ancestor(last, firstBest(s.delta, s.lo, s.hi), at);
-    const auto& n = s.graph.nodes[static_cast<std::size_t>(node)];
-    const bool word =
-        n.kind == AlignmentNode::Kind::Phoneme || n.kind == AlignmentNode::Kind::Pause;
-    return word ? n.phoneme : -1;
+    std::fill(out.begin(), out.end(), -1);
+    if (s.frames == 0) return;
+    int node = firstBest(s.delta, s.lo, s.hi);
+    for (std::int64_t f = s.frames - 1, k = 0; k < std::ssize(out) && f >= s.windowStart;
+         ++k, --f) {
+        const auto& n = s.graph.nodes[static_cast<std::size_t>(node)];
+        const bool word =
+            n.kind == AlignmentNode::Kind::Phoneme || n.kind == AlignmentNode::Kind::Pause;
+        out[static_cast<std::size_t>(k)] = word ? n.phoneme : -1;
+        if (f > s.windowStart) node = s.ancestor(f, node, f - 1);
+    }
 }
 
 double ForcedAligner::minimumSeconds() const {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <lipsyncd/dsp.hpp>
 #include <string>
+#include <utility>
 
 #include "AlignerInput.hpp"
 
@@ -37,6 +38,15 @@ LineFollower::LineFollower(std::span<const ScriptWord> script, const PhonemeSet&
       mixed_(set.size()) {
     aligner_.followOnly();
     held_.resize(static_cast<std::size_t>(lag_) + 1);
+    path_.resize(static_cast<std::size_t>(lag_) + 1);
+}
+
+// The class the best path gives the frame `back` before the newest: the words', or the front
+// end's own in a stretch no word explains.
+int LineFollower::classBack(int back) const {
+    const int c = path_[static_cast<std::size_t>(back)];
+    if (c >= 0) return c;
+    return held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))].heard;
 }
 
 void LineFollower::push(const FrameLabel& label, std::span<const float> templateDistances,
@@ -45,35 +55,45 @@ void LineFollower::push(const FrameLabel& label, std::span<const float> template
     pushFrame(aligner_, label.time, templateDistances, term_, share_, label.silent, mixed_);
     held_[static_cast<std::size_t>(frames_ % std::ssize(held_))] = {label.time, label.phoneme};
     ++frames_;
-    if (frames_ <= lag_) return;
-    const auto& frame = held_[static_cast<std::size_t>((frames_ - 1 - lag_) % std::ssize(held_))];
-    place(frame, aligner_.phonemeBack(lag_));
+    aligner_.phonemesBack(path_);
+    if (frames_ > lag_)
+        place(held_[static_cast<std::size_t>((frames_ - 1 - lag_) % std::ssize(held_))],
+              classBack(lag_));
+    // What the best path goes on to after the open phoneme, in the frames not decided yet.
+    upcoming_ = {};
+    const int undecided = static_cast<int>(std::min<std::int64_t>(lag_, frames_));
+    for (int back = undecided - 1; back >= 0; --back) {
+        const int c = classBack(back);
+        if (c == open_.phoneme) continue;
+        const double time =
+            held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))].time;
+        upcoming_ = {c, std::max(0.0, time - hop_ / 2), 0};
+        break;
+    }
 }
 
 void LineFollower::finish() {
     // The newest frames, on the best path as it stands at the end (the oldest lag back).
-    for (int back = static_cast<int>(std::min<std::int64_t>(lag_, frames_)) - 1; back >= 0;
-         --back) {
-        const auto& frame =
-            held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))];
-        place(frame, aligner_.phonemeBack(back));
-    }
+    for (int back = static_cast<int>(std::min<std::int64_t>(lag_, frames_)) - 1; back >= 0; --back)
+        place(held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))],
+              classBack(back));
+    upcoming_ = {};
     if (open_.phoneme >= 0 && sink_)
         sink_({open_.start, open_.end, (*set_)[static_cast<std::size_t>(open_.phoneme)].name});
     open_ = {};
 }
 
-// One frame's class, from the words or (-1) the front end: a new segment when it changes.
-void LineFollower::place(const Held& frame, int phoneme) {
-    const int c = phoneme >= 0 ? phoneme : frame.heard;
+// One frame's class: a new segment when it changes. The new one is open before the old one
+// goes to the sink, so that the sink sees what comes next.
+void LineFollower::place(const Held& frame, int c) {
     const double start = std::max(0.0, frame.time - hop_ / 2), end = frame.time + hop_ / 2;
     if (c == open_.phoneme) {
         open_.end = end;
         return;
     }
-    if (open_.phoneme >= 0 && sink_)
-        sink_({open_.start, start, (*set_)[static_cast<std::size_t>(open_.phoneme)].name});
-    open_ = {c, start, end};
+    const auto closed = std::exchange(open_, {c, start, end});
+    if (closed.phoneme >= 0 && sink_)
+        sink_({closed.start, start, (*set_)[static_cast<std::size_t>(closed.phoneme)].name});
 }
 
 }  // namespace lipsyncd::dsp

@@ -46,6 +46,13 @@ void StreamingRuntime::push(const PhonemeSegment& segment, PoseTrack& out) {
     }
     window_.push_back(segment);
     emitUntil(segment.end - delay_, false, out);
+    expected_.reset();
+}
+
+void StreamingRuntime::expect(const std::string& phoneme, double from) {
+    if (!expected_) expected_.emplace();
+    expected_->start = from;
+    expected_->phoneme = phoneme;
 }
 
 void StreamingRuntime::preview(const std::string& phoneme, double until, PoseTrack& out) {
@@ -58,6 +65,7 @@ void StreamingRuntime::preview(const std::string& phoneme, double until, PoseTra
     if (!(until > from)) return;
     const PhonemeSegment open{from, until, phoneme, 0};
     emitUntil(until, false, out, &open);
+    expected_.reset();
 }
 
 void StreamingRuntime::finish(PoseTrack& out) {
@@ -105,7 +113,8 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
 }
 
 // The segments the steps run over: the window, and in the causal mode what comes next, unknown
-// yet: the last phoneme (or the open one) going on for a typical length.
+// yet: the last phoneme (or the open one) going on for a typical length, or, when expect()
+// said what follows, that after it.
 void StreamingRuntime::buildSchedule(bool causal, const PhonemeSegment* open) {
     schedule_.assign(window_.begin(), window_.end());
     if (!causal) return;
@@ -113,11 +122,18 @@ void StreamingRuntime::buildSchedule(bool causal, const PhonemeSegment* open) {
     for (const auto& s : window_) total += s.duration();
     const double typical = window_.empty() ? 0.1 : total / static_cast<double>(window_.size());
     if (open) {
-        schedule_.push_back(
-            {open->start, std::max(open->end, open->start + typical), open->phoneme, 0});
+        if (expected_ && expected_->start > open->start) {
+            const double next = std::max(open->end, expected_->start);
+            schedule_.push_back({open->start, next, open->phoneme, 0});
+            schedule_.push_back({next, next + typical, expected_->phoneme, 0});
+        } else {
+            schedule_.push_back(
+                {open->start, std::max(open->end, open->start + typical), open->phoneme, 0});
+        }
     } else {
         const auto& last = window_.back();
-        schedule_.push_back({last.end, last.end + typical, last.phoneme, 0});
+        const auto& next = expected_ ? expected_->phoneme : last.phoneme;
+        schedule_.push_back({last.end, last.end + typical, next, 0});
     }
 }
 

@@ -72,7 +72,7 @@ TEST(LineFollower, DecidesEachFrameALagBehindTheNewest) {
     EXPECT_EQ(follower.lagFrames(), static_cast<int>(std::lround(0.1 / hop)));
     auto decoder = dsp::AudioDecoder::open(s.file);
     dsp::StreamingAnalyzer analyzer(templates, PhonemeSet::common(), decoder.sampleRate());
-    int frames = 0;
+    int frames = 0, upcoming = 0;
     double newest = 0;
     PhonemeSchedule out;
     follower.onSegment([&](const PhonemeSegment& seg) { out.push_back(seg); });
@@ -85,6 +85,14 @@ TEST(LineFollower, DecidesEachFrameALagBehindTheNewest) {
         } else {
             EXPECT_NEAR(follower.openUntil(), newest - 0.1 + hop / 2, 1e-6);
         }
+        // What the path goes on to, among the frames not decided yet: another phoneme, after
+        // the decided ones, by the newest.
+        if (follower.upcomingPhoneme() >= 0) {
+            ++upcoming;
+            EXPECT_NE(follower.upcomingPhoneme(), follower.openPhoneme());
+            EXPECT_GE(follower.upcomingStart(), follower.openUntil() - 1e-9);
+            EXPECT_LE(follower.upcomingStart(), newest);
+        }
     });
     std::vector<float> block(4096);
     while (const auto n = decoder.read(block)) analyzer.push(std::span(block.data(), n));
@@ -93,6 +101,7 @@ TEST(LineFollower, DecidesEachFrameALagBehindTheNewest) {
     ASSERT_FALSE(out.empty());
     EXPECT_NEAR(out.back().end, newest + hop / 2, 1e-6);
     EXPECT_EQ(follower.openPhoneme(), -1);
+    EXPECT_GT(upcoming, frames / 4);
 }
 
 // Words the performer adds to the line are not forced into the line's words: with only the

@@ -1086,10 +1086,10 @@ class ForcedAligner {
     // not kept (finish() then places no word) and the room for the windows of the config's
     // lookaheadSeconds and commitSeconds is reserved now, so push() never allocates.
     void followOnly();
-    // The phoneme (index into the set) the best partial path so far held `lagFrames` frames
-    // before the newest (at most lookaheadSeconds back); a pause between words is silence;
-    // -1 in a stretch no word explains (a filler) and before the first frame.
-    int phonemeBack(int lagFrames) const;
+    // The phonemes (indices into the set) the best partial path so far holds, out[k] in the
+    // frame k before the newest (at most lookaheadSeconds back): a pause between words is
+    // silence; -1 in a stretch no word explains (a filler) and before the first frame.
+    void phonemesBack(std::span<int> out) const;
     // The shortest audio the script fits in (minimum durations), seconds.
     double minimumSeconds() const;
     // Largest number of frames of back-pointers held at once (the memory bound, for tests).
@@ -1140,7 +1140,7 @@ AlignFileResult alignFile(const std::filesystem::path& file, std::span<const Scr
 
 // A line whose words are known, followed as it is said (the service's live lines after a cue):
 // a fixed-lag forced alignment. Each frame's class is the one the best partial path held `lag`
-// frames after it (ForcedAligner::phonemeBack); where no word explains the sound (a cough, an
+// frames after it (ForcedAligner::phonemesBack); where no word explains the sound (a cough, an
 // added word) it is the front end's own class for the frame. The speaking rate is unknown while
 // the line is said: the synthesiser's durations are taken as they are (time scale 1).
 class LineFollower {
@@ -1161,6 +1161,10 @@ class LineFollower {
     // The phoneme of the segment still open (-1: none yet) and the end of its newest frame.
     int openPhoneme() const { return open_.phoneme; }
     double openUntil() const { return open_.end; }
+    // What the best path so far goes on to after the open phoneme, among the frames not
+    // decided yet (-1: nothing else yet), and where it begins: a guess the lag may still change.
+    int upcomingPhoneme() const { return upcoming_.phoneme; }
+    double upcomingStart() const { return upcoming_.start; }
     // The line is over: the frames held back go to the best path's ends, and the open segment
     // closes.
     void finish();
@@ -1172,6 +1176,7 @@ class LineFollower {
         int heard = 0;  // the front end's own class
     };
     void place(const Held& frame, int phoneme);
+    int classBack(int back) const;
 
     const PhonemeSet* set_;
     ForcedAligner aligner_;
@@ -1180,11 +1185,12 @@ class LineFollower {
     float share_;
     std::vector<float> term_, mixed_;
     std::vector<Held> held_;  // the last lag_ + 1 frames, a ring
+    std::vector<int> path_;   // the best path's phonemes back from the newest frame
     std::int64_t frames_ = 0;
     struct Open {
         int phoneme = -1;
         double start = 0, end = 0;
-    } open_;
+    } open_, upcoming_;
     SegmentSink sink_;
 };
 

@@ -306,6 +306,10 @@ class StreamingRuntime {
     // `until`; frames up to `until` go out now, warped as if it lasts as long as the phonemes
     // so far on average. When it closes, push() carries on from there with the truth.
     void preview(const std::string& phoneme, double until, PoseTrack& out);
+    // Causal mode only, before a push() or preview(): what is expected to come next, from
+    // `from` on (a followed line's words say it). The guess of what follows the newest phoneme
+    // takes it, instead of that phoneme going on; it holds for that one call.
+    void expect(const std::string& phoneme, double from);
     double delaySeconds() const { return delay_; }
 
   private:
@@ -328,6 +332,7 @@ class StreamingRuntime {
     std::vector<float> last_;  // the last frame out
     // Each emitUntil's working state, kept so that it reuses their memory instead of allocating.
     std::vector<PhonemeSegment> schedule_;  // window_, plus the causal mode's estimate
+    std::optional<PhonemeSegment> expected_;  // expect(): for the next push or preview only
     PoseCurves curves_;
     SpeedLimitScratch speed_;
 };
