@@ -50,8 +50,9 @@ constexpr ControlArg kOnArg[] = {
 
 constexpr ControlCommand kCommands[] = {
     {"line",
-     "line [TEXT]: the performer says TEXT live next; once it is over (the next line, `line` "
-     "alone, live off) its words teach the show's voice",
+     "line [TEXT]: the performer says TEXT live next: the mouth follows its words while it is "
+     "said, and once it is over (the next line, `line` alone, live off) they teach the show's "
+     "voice",
      "text", kLineArgs},
     {"live", "live on|off: follow the microphone", "on", kOnArg},
     {"play", "play FILE: queue an audio file", "file", kPlayArgs},
