@@ -241,8 +241,22 @@ TEST(LiveLine, WithoutAdaptSpeakerALineIsFollowedOnlyAndWithoutEitherRefused) {
     EXPECT_TRUE(line.value("following", false)) << line.dump();
     // Nothing is kept to learn from.
     EXPECT_EQ(cf.request({{"cmd", "status"}})["memory"]["live_line_bytes"], 0);
+    // Words espeak-ng cannot read: the line is taken, the mouth follows the audio alone, and
+    // subscribers and the log say why.
+    EXPECT_TRUE(cf.request({{"cmd", "line"}, {"text", "?!"}})["ok"]);
+    event = json::object();
+    for (int i = 0; i < 500 && event.value("event", "") != "following"; ++i) {
+        event = json::parse(watcher.readLine(), nullptr, false);
+        if (!event.is_object()) event = json::object();
+    }
+    EXPECT_NE(event.value("error", "").find("found no words it can read"), std::string::npos)
+        << event.dump();
+    EXPECT_FALSE(cf.request({{"cmd", "status"}})["live_line"].value("following", true));
     EXPECT_TRUE(cf.request({{"cmd", "line"}})["learning"].is_null());
     EXPECT_EQ(f.stop(), 0);
+    EXPECT_NE(f.log().find("live line '?!': the mouth follows the audio alone: espeak-ng"),
+              std::string::npos)
+        << f.log();
 }
 
 }  // namespace
