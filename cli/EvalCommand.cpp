@@ -151,25 +151,38 @@ struct Evaluator {
             speaker = &it->second;
         }
         if (!o.align) return analyse(item, speaker, true);
-        if (o.followLag >= 0) return follow(item, speaker);
-        if (auto r = align(item, speaker)) return {std::move(r->schedule), std::move(r->levels)};
+        if (o.followLag >= 0) {
+            if (auto r = follow(item, speaker)) return std::move(*r);
+        } else if (auto r = align(item, speaker)) {
+            return {std::move(r->schedule), std::move(r->levels)};
+        }
         return analyse(item, speaker, false);
+    }
+
+    // How messages about a file begin.
+    static std::string where(const CorpusItem& item) {
+        return "lipsync eval: " + item.speaker + '/' + item.name + ": ";
+    }
+
+    // The voice a speaker's earlier files taught (none: no speaker, or nothing heard yet).
+    std::optional<dsp::TemplateSet> learnt(const dsp::SpeakerAdaptation* speaker) const {
+        return speaker ? speaker->adaptedIfHeard(o.aligner.config.speakerAdaptationPriorFrames)
+                       : std::nullopt;
     }
 
     // Words that cannot be aligned at all (none the voice can read, say) leave the file to the
     // audio alone, as the service does with such a file, and the run goes on.
     std::optional<dsp::AlignFileResult> align(const CorpusItem& item,
                                               dsp::SpeakerAdaptation* speaker) const {
-        const auto where = "lipsync eval: " + item.speaker + '/' + item.name + ": ";
         try {
             auto r =
                 alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
                           voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner.config,
                           o.frontEnd.decode(), std::nullopt, o.aligner.reductions, speaker);
-            for (const auto& w : r.warnings) std::cerr << where << w << '\n';
+            for (const auto& w : r.warnings) std::cerr << where(item) << w << '\n';
             return r;
         } catch (const InputError& e) {
-            std::cerr << where << "words not used: " << e.what() << "; audio-only analysis\n";
+            std::cerr << where(item) << "words not used: " << e.what() << "; audio-only analysis\n";
             return std::nullopt;
         }
     }
@@ -181,9 +194,7 @@ struct Evaluator {
     std::pair<PhonemeSchedule, LevelTrack> analyse(const CorpusItem& item,
                                                    dsp::SpeakerAdaptation* speaker,
                                                    bool teach) const {
-        const auto own =
-            speaker ? speaker->adaptedIfHeard(o.aligner.config.speakerAdaptationPriorFrames)
-                    : std::nullopt;
+        const auto own = learnt(speaker);
         auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
                                   o.frontEnd.decode(), std::nullopt);
         printWarnings("eval", a.warnings);
@@ -193,11 +204,10 @@ struct Evaluator {
 
     // --follow-lag: as the service follows a live line after its cue, on the voice the
     // speaker's earlier lines taught; once over, the line's words teach the voice in turn.
-    std::pair<PhonemeSchedule, LevelTrack> follow(const CorpusItem& item,
-                                                  dsp::SpeakerAdaptation* speaker) const {
-        const auto own =
-            speaker ? speaker->adaptedIfHeard(o.aligner.config.speakerAdaptationPriorFrames)
-                    : std::nullopt;
+    // Words that cannot be read leave the file to the audio alone, as align() does.
+    std::optional<std::pair<PhonemeSchedule, LevelTrack>> follow(
+        const CorpusItem& item, dsp::SpeakerAdaptation* speaker) const {
+        const auto own = learnt(speaker);
         try {
             auto a = followText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
                                 voiceFor(item.speaker), own ? *own : templates, o.followLag,
@@ -205,11 +215,10 @@ struct Evaluator {
                                 o.aligner.reductions);
             printWarnings("eval", a.warnings);
             if (speaker) align(item, speaker);
-            return {std::move(a.schedule), std::move(a.levels)};
+            return std::pair(std::move(a.schedule), std::move(a.levels));
         } catch (const InputError& e) {
-            std::cerr << "lipsync eval: " << item.speaker << '/' << item.name
-                      << ": words not used: " << e.what() << "; audio-only analysis\n";
-            return analyse(item, speaker, false);
+            std::cerr << where(item) << "words not used: " << e.what() << "; audio-only analysis\n";
+            return std::nullopt;
         }
     }
 
@@ -251,8 +260,7 @@ struct Evaluator {
             try {
                 path->follow(maker.readLine(text, *synth), mouth);
             } catch (const InputError& e) {
-                std::cerr << "lipsync eval: " << item.speaker << '/' << item.name
-                          << ": words not followed: " << e.what() << '\n';
+                std::cerr << where(item) << "words not followed: " << e.what() << '\n';
             }
         }
         const auto block = static_cast<std::size_t>(audio.sampleRate / 100);

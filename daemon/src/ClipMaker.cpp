@@ -190,13 +190,13 @@ std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
 std::vector<dsp::ScriptWord> ClipMaker::readLine(const std::string& text,
                                                  EspeakSynthesizer& synth) const {
     const auto& voice = impl_->config.voice;
-    const auto set = espeakMapForVoice(voice).phonemeSet();
+    const auto map = espeakMapForVoice(voice);
     // Live input is analysed in the common set (StreamingLive).
-    if (&PhonemeSet::named(set) != &PhonemeSet::common())
-        throw InputError("voice '" + voice + "' reads words in the '" + set +
+    if (&PhonemeSet::named(map.phonemeSet()) != &PhonemeSet::common())
+        throw InputError("voice '" + voice + "' reads words in the '" + map.phonemeSet() +
                          "' phoneme set; live input is heard in the common set");
     std::vector<std::string> warnings;
-    return scriptForVoice(synth, text, voice, &warnings);
+    return scriptForVoice(synth, text, voice, map, &warnings);
 }
 
 }  // namespace lipsyncd::daemon

@@ -41,12 +41,17 @@ LineFollower::LineFollower(std::span<const ScriptWord> script, const PhonemeSet&
     path_.resize(static_cast<std::size_t>(lag_) + 1);
 }
 
+// The frame `back` before the newest (at most lag_), from the ring.
+const LineFollower::Held& LineFollower::heldBack(int back) const {
+    return held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))];
+}
+
 // The class the best path gives the frame `back` before the newest: the words', or the front
 // end's own in a stretch no word explains.
 int LineFollower::classBack(int back) const {
     const int c = path_[static_cast<std::size_t>(back)];
     if (c >= 0) return c;
-    return held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))].heard;
+    return heldBack(back).heard;
 }
 
 void LineFollower::push(const FrameLabel& label, std::span<const float> templateDistances,
@@ -56,18 +61,14 @@ void LineFollower::push(const FrameLabel& label, std::span<const float> template
     held_[static_cast<std::size_t>(frames_ % std::ssize(held_))] = {label.time, label.phoneme};
     ++frames_;
     aligner_.phonemesBack(path_);
-    if (frames_ > lag_)
-        place(held_[static_cast<std::size_t>((frames_ - 1 - lag_) % std::ssize(held_))],
-              classBack(lag_));
+    if (frames_ > lag_) place(lag_);
     // What the best path goes on to after the open phoneme, in the frames not decided yet.
     upcoming_ = {};
     const int undecided = static_cast<int>(std::min<std::int64_t>(lag_, frames_));
     for (int back = undecided - 1; back >= 0; --back) {
         const int c = classBack(back);
         if (c == open_.phoneme) continue;
-        const double time =
-            held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))].time;
-        upcoming_ = {c, std::max(0.0, time - hop_ / 2), 0};
+        upcoming_ = {c, std::max(0.0, heldBack(back).time - hop_ / 2), 0};
         break;
     }
 }
@@ -75,17 +76,18 @@ void LineFollower::push(const FrameLabel& label, std::span<const float> template
 void LineFollower::finish() {
     // The newest frames, on the best path as it stands at the end (the oldest lag back).
     for (int back = static_cast<int>(std::min<std::int64_t>(lag_, frames_)) - 1; back >= 0; --back)
-        place(held_[static_cast<std::size_t>((frames_ - 1 - back) % std::ssize(held_))],
-              classBack(back));
+        place(back);
     upcoming_ = {};
     if (open_.phoneme >= 0 && sink_)
         sink_({open_.start, open_.end, (*set_)[static_cast<std::size_t>(open_.phoneme)].name});
     open_ = {};
 }
 
-// One frame's class: a new segment when it changes. The new one is open before the old one
-// goes to the sink, so that the sink sees what comes next.
-void LineFollower::place(const Held& frame, int c) {
+// The frame `back` before the newest is decided: a new segment when its class changes. The new
+// one is open before the old one goes to the sink, so that the sink sees what comes next.
+void LineFollower::place(int back) {
+    const auto& frame = heldBack(back);
+    const int c = classBack(back);
     const double start = std::max(0.0, frame.time - hop_ / 2), end = frame.time + hop_ / 2;
     if (c == open_.phoneme) {
         open_.end = end;

@@ -66,7 +66,8 @@ TEST(LineFollower, DecidesEachFrameALagBehindTheNewest) {
     const auto s = speak(kLine, "follow_lag.wav");
     const auto templates = dsp::TemplateSet::loadDefault();
     std::vector<std::string> warnings;
-    const auto script = scriptForVoice(test::espeak(), kLine, "en-us", &warnings);
+    const auto script =
+        scriptForVoice(test::espeak(), kLine, "en-us", espeakMapForVoice("en-us"), &warnings);
     const double hop = templates.analysis.hopSeconds;
     dsp::LineFollower follower(script, PhonemeSet::common(), hop, 0.1);
     EXPECT_EQ(follower.lagFrames(), static_cast<int>(std::lround(0.1 / hop)));

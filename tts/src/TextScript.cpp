@@ -100,9 +100,8 @@ std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::
 }
 
 std::vector<dsp::ScriptWord> scriptForVoice(EspeakSynthesizer& synth, const std::string& text,
-                                            const std::string& voice,
+                                            const std::string& voice, const PhonemeMap& map,
                                             std::vector<std::string>* warnings, bool reductions) {
-    const auto map = espeakMapForVoice(voice);
     const auto weakForms = reductions ? Reductions::forVoice(voice, map) : Reductions{};
     return scriptForText(synth, text, voice, map, warnings, &weakForms);
 }
@@ -115,8 +114,9 @@ dsp::AlignFileResult alignText(EspeakSynthesizer& synth, const std::filesystem::
                                const std::optional<dsp::RawFormat>& raw, bool reductions,
                                dsp::SpeakerAdaptation* speaker) {
     std::vector<std::string> warnings;
-    const auto script = scriptForVoice(synth, text, voice, &warnings, reductions);
-    const auto& set = PhonemeSet::named(espeakMapForVoice(voice).phonemeSet());
+    const auto map = espeakMapForVoice(voice);
+    const auto script = scriptForVoice(synth, text, voice, map, &warnings, reductions);
+    const auto& set = PhonemeSet::named(map.phonemeSet());
     auto result =
         dsp::alignFile(audio, script, templates, set, frontEnd, aligner, decode, raw, speaker);
     result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
@@ -130,8 +130,9 @@ dsp::AnalysisResult followText(EspeakSynthesizer& synth, const std::filesystem::
                                const dsp::AlignerConfig& aligner, const dsp::DecodeOptions& decode,
                                bool reductions) {
     std::vector<std::string> warnings;
-    const auto script = scriptForVoice(synth, text, voice, &warnings, reductions);
-    const auto& set = PhonemeSet::named(espeakMapForVoice(voice).phonemeSet());
+    const auto map = espeakMapForVoice(voice);
+    const auto script = scriptForVoice(synth, text, voice, map, &warnings, reductions);
+    const auto& set = PhonemeSet::named(map.phonemeSet());
     auto result =
         dsp::followFile(audio, script, templates, set, lagSeconds, frontEnd, aligner, decode);
     result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());

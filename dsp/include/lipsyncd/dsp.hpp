@@ -1175,7 +1175,8 @@ class LineFollower {
         double time = 0;
         int heard = 0;  // the front end's own class
     };
-    void place(const Held& frame, int phoneme);
+    void place(int back);
+    const Held& heldBack(int back) const;
     int classBack(int back) const;
 
     const PhonemeSet* set_;

@@ -104,10 +104,11 @@ std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::
                                            std::vector<std::string>* warnings,
                                            const Reductions* reductions = nullptr);
 
-// scriptForText with the voice's own phoneme map (espeakMapForVoice) and, with `reductions`,
-// its language's common reductions: what alignText, followText and the service's live lines read.
+// scriptForText with the voice's phoneme map (espeakMapForVoice, loaded by the caller, who
+// needs its phoneme set too) and, with `reductions`, its language's common reductions: what
+// alignText, followText and the service's live lines read.
 std::vector<dsp::ScriptWord> scriptForVoice(EspeakSynthesizer& synth, const std::string& text,
-                                            const std::string& voice,
+                                            const std::string& voice, const PhonemeMap& map,
                                             std::vector<std::string>* warnings,
                                             bool reductions = true);
 
