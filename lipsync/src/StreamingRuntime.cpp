@@ -24,8 +24,10 @@ StreamingRuntime::StreamingRuntime(const BigramCurveSet& set, const PoseSet& pos
       curves_(poses.size(), config.outputRate, 0, 0, 0),
       speed_(poses) {
     // Room for what a window holds (the delay, the smoothing window and a margin, two segments
-    // more, the causal estimate) at one segment per 10 ms analysis hop, and for its frames with
-    // a phoneme held open for a few seconds. Anything longer grows them once, geometrically.
+    // more, the causal estimate) at one segment per 10 ms analysis hop, and for its frames and a
+    // few seconds let out at once (a push after a long segment, with a delay). The steps never
+    // run over more than that past (pastKept()), however long a pause lasts; only a push that
+    // lets out more than a few seconds at once grows them, geometrically.
     constexpr double kSegmentsPerSecond = 100, kOpenSeconds = 4;
     const double kept = delay_ + longestWindow() + 0.05;
     const auto segments = static_cast<std::size_t>(kept * kSegmentsPerSecond) + 4;
@@ -79,9 +81,12 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
     const double rate = config_.outputRate;
     const auto lastFrame = static_cast<long long>(std::floor((until - origin_) * rate + 1e-9));
     if (lastFrame < static_cast<long long>(emitted_)) return;
+    // The steps run from the window's start, or from the past that can still change a frame
+    // to come (pastKept()) where that is later: a pause heard live is one open segment that
+    // grows as long as the pause lasts, and each tick's work and memory must not grow with it.
     const double windowStart = window_.empty() ? open->start : window_.front().start;
-    const auto firstFrame =
-        static_cast<std::size_t>(std::max(0.0, std::ceil((windowStart - origin_) * rate - 1e-9)));
+    const auto firstFrame = static_cast<std::size_t>(std::max(
+        {0.0, std::ceil((windowStart - origin_) * rate - 1e-9), std::ceil((pastKept() - origin_) * rate - 1e-9)}));
     // Work past the last frame to let out by a smoothing window, so that a curve cut short
     // there does not look like a peak to the valley smoothing.
     const double knownEnd = open ? open->end : window_.back().end;
@@ -118,9 +123,14 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
 void StreamingRuntime::buildSchedule(bool causal, const PhonemeSegment* open) {
     schedule_.assign(window_.begin(), window_.end());
     if (!causal) return;
+    // The typical length is the phonemes' heard: a pause says nothing about how long the next
+    // phoneme lasts, and a long one would stretch the guess over seconds.
     double total = 0;
-    for (const auto& s : window_) total += s.duration();
-    const double typical = window_.empty() ? 0.1 : total / static_cast<double>(window_.size());
+    std::size_t counted = 0;
+    const auto& silence = (*phonemes_)[phonemes_->silence()].name;
+    for (const auto& s : window_)
+        if (s.phoneme != silence) total += s.duration(), ++counted;
+    const double typical = counted == 0 ? 0.1 : total / static_cast<double>(counted);
     if (open) {
         if (expected_ && expected_->start > open->start) {
             const double next = std::max(open->end, expected_->start);
@@ -138,8 +148,7 @@ void StreamingRuntime::buildSchedule(bool causal, const PhonemeSegment* open) {
 }
 
 // What a fresh PoseCurves(poses, rate, origin_, firstFrame, frames) holds (every value 0), in
-// curves_'s memory. A longer window than any before grows it by at least double, so that a
-// phoneme held open (a long pause heard live) reallocates only now and then, not every tick.
+// curves_'s memory. A longer stretch than any before grows it by at least double.
 void StreamingRuntime::resetCurves(std::size_t firstFrame, std::size_t frames) {
     curves_.startTime = origin_;
     curves_.firstFrame = firstFrame;
@@ -158,9 +167,14 @@ double StreamingRuntime::longestWindow() const {
     return longest;
 }
 
+// Frames before this cannot change a frame not yet out: the valley smoothing reaches back a
+// smoothing window, and nothing else looks back further than the frame before.
+double StreamingRuntime::pastKept() const {
+    return origin_ + static_cast<double>(emitted_) / config_.outputRate - longestWindow() - 0.05;
+}
+
 void StreamingRuntime::dropOldSegments() {
-    const double keepFrom =
-        origin_ + static_cast<double>(emitted_) / config_.outputRate - longestWindow() - 0.05;
+    const double keepFrom = pastKept();
     while (window_.size() > 3 && window_[2].start <= keepFrom) {
         window_.erase(window_.begin());
         atStart_ = false;

@@ -154,6 +154,47 @@ TEST(StreamingRuntime, AnExpectedNextPhonemeBringsTheCausalModeCloserToTheOfflin
     EXPECT_LT(told, untold * 0.5) << told << " against " << untold;  // measured 0.33
 }
 
+// The causal mode, ticked every 10 ms as the service's live mode runs it: the segments closed
+// by each tick, then the phoneme still open.
+PoseTrack tickedCausally(const PhonemeSchedule& s) {
+    lipsync::StreamingRuntime stream(shipped().curves, shipped().poses, 0);
+    PoseTrack out;
+    std::size_t next = 0;
+    for (int tick = 1; next < s.size(); ++tick) {
+        const double now = 0.01 * tick;
+        while (next < s.size() && s[next].end <= now + 1e-9) stream.push(s[next++], out);
+        if (next < s.size()) stream.preview(s[next].phoneme, now, out);
+    }
+    return out;
+}
+
+// How the live mouth says a line does not depend on how long the pause before it lasted: the
+// guess of how long the open phoneme goes on comes from the phonemes heard, not from the pause
+// (a minute's wait once stretched that guess over seconds, and the first phonemes after it
+// barely moved the mouth).
+TEST(StreamingRuntime, TheCausalModeSaysALineAlikeAfterAShortOrALongPause) {
+    std::mt19937 rng(19);
+    const auto before = randomSchedule(rng, 10), line = randomSchedule(rng, 12);
+    const auto after = [&](double pause) {
+        auto s = before;
+        const double start = s.back().end + pause;
+        s.push_back({s.back().end, start, "sil", 1});
+        for (auto seg : line) s.push_back({seg.start + start, seg.end + start, seg.phoneme, 1});
+        return std::pair{tickedCausally(s), start};
+    };
+    const auto [shortly, shortStart] = after(0.5);
+    const auto [later, longStart] = after(30);
+    double difference = 0, total = 0;
+    const auto lineFrames = static_cast<std::size_t>(line.back().end * 100);
+    for (std::size_t f = 0; f < lineFrames; ++f) {
+        const auto a = shortly.frame(static_cast<std::size_t>(std::lround(shortStart * 100)) + f);
+        const auto b = later.frame(static_cast<std::size_t>(std::lround(longStart * 100)) + f);
+        for (std::size_t p = 0; p < a.size(); ++p)
+            difference += std::abs(a[p] - b[p]), total += a[p];
+    }
+    EXPECT_LT(difference, 0.01 * total);  // measured 0; 5 % when the pause counted
+}
+
 TEST(StreamingRuntime, ASegmentThatLeavesAGapIsRefused) {
     lipsync::StreamingRuntime stream(shipped().curves, shipped().poses, 0.5);
     PoseTrack out;

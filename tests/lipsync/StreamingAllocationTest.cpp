@@ -68,5 +68,25 @@ TEST(StreamingAllocations, TheDelayedModeAllocatesNothingOnceWarmedUp) {
     EXPECT_EQ(allocationsAfterWarmUp(stream, s, 1.0), 0);
 }
 
+// A live show waits minutes between lines: the pause is one segment held open all that time.
+// Each tick's work and memory stay those of a short window (before, each tick reran the steps
+// over the whole pause, and the buffers grew with it: a minute of pause cost 25 us a tick more).
+PhonemeSchedule speechAroundAPause(double pauseSeconds) {
+    auto s = speech(3);
+    const double resume = s.back().end + pauseSeconds;
+    s.push_back({s.back().end, resume, "sil", 1});
+    for (auto seg : speech(3)) {
+        seg.start += resume, seg.end += resume;
+        s.push_back(seg);
+    }
+    return s;
+}
+
+TEST(StreamingAllocations, ALongPauseHeldOpenAllocatesNothing) {
+    const auto s = speechAroundAPause(60);
+    lipsync::StreamingRuntime stream(shipped().curves, shipped().poses, 0);
+    EXPECT_EQ(allocationsAfterWarmUp(stream, s, 1.0), 0);
+}
+
 }  // namespace
 }  // namespace lipsyncd::test

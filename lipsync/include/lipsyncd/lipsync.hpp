@@ -291,9 +291,10 @@ PoseTrack animateFilter(std::span<const PhonemeSegment> schedule, const BigramCu
 // delay = 0 is the causal mode: the next phoneme is unknown, so frames up to the last closed
 // boundary are computed against an estimate (the current phoneme continued, for its mean
 // duration so far) and go out at once.
-// It runs on the live path (a push or preview every 10 ms): once its buffers have grown to the
-// longest window seen (reserved up front for a few seconds), push() and preview() allocate
-// nothing.
+// It runs on the live path (a push or preview every 10 ms): its work and memory per call are
+// bounded by the smoothing window and the delay, not by how long a phoneme or a pause lasts,
+// and preview() and push() allocate nothing (a push that lets out more than a few seconds at
+// once, after a long segment with a delay, grows its buffers once).
 class StreamingRuntime {
   public:
     StreamingRuntime(const BigramCurveSet& set, const PoseSet& poses, double delaySeconds,
@@ -317,6 +318,7 @@ class StreamingRuntime {
     void buildSchedule(bool causal, const PhonemeSegment* open);
     void resetCurves(std::size_t firstFrame, std::size_t frames);
     void dropOldSegments();
+    double pastKept() const;
     double longestWindow() const;
 
     const BigramCurveSet* set_;
