@@ -98,7 +98,14 @@ void Daemon::Impl::tick() {
     }
 }
 
+void Daemon::Impl::timedTick(std::uint64_t expirations) {
+    const double before = threadCpuSeconds();
+    tick();
+    loop.tick(threadCpuSeconds() - before, expirations > 1 ? expirations - 1 : 0);
+}
+
 void Daemon::Impl::reportFailures() {
+    if (const auto behind = loop.warning(now())) logWarning(*behind);
     for (const auto& f : queue.takeFailures()) {
         logWarning("cannot play " + f);
         control->broadcast(json{{"event", "failed"}, {"error", f}});
@@ -157,6 +164,7 @@ int Daemon::run() {
             fds.assign({{sigfd, POLLIN, 0}, {timer, POLLIN, 0}});
             d.control->addPollFds(fds);
             if (::poll(fds.data(), fds.size(), 1000) < 0 && errno != EINTR) break;
+            const double turnStarted = threadCpuSeconds();
             signalfd_siginfo si{};
             while (::read(sigfd, &si, sizeof si) == sizeof si) {
                 if (si.ssi_signo == SIGHUP)
@@ -165,9 +173,11 @@ int Daemon::run() {
                     exitSignal = static_cast<int>(si.ssi_signo);
             }
             std::uint64_t expirations = 0;
-            if (::read(timer, &expirations, sizeof expirations) == sizeof expirations) d.tick();
+            if (::read(timer, &expirations, sizeof expirations) == sizeof expirations)
+                d.timedTick(expirations);
             d.control->service([&](const json& r) { return d.handle(r); });
             d.reportFailures();
+            d.loop.turn(threadCpuSeconds() - turnStarted);
         }
     } catch (const std::exception& e) {
         logError(std::string("stopping on an error: ") + e.what());

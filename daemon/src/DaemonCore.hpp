@@ -10,6 +10,7 @@
 #include "ControlServer.hpp"
 #include "FrameEvent.hpp"
 #include "LiveMode.hpp"
+#include "LoopHealth.hpp"
 #include "Player.hpp"
 #include "PoseHold.hpp"
 #include "Setup.hpp"
@@ -33,11 +34,13 @@ struct Daemon::Impl {
     double lastEvent = 0, lastWatchdog = 0;
     std::uint64_t watchdogUsec = 0;
     std::size_t clipsPlayed = 0;
+    LoopHealth loop;  // whether the 10 ms loop keeps up (status "loop")
 
     explicit Impl(std::filesystem::path file);
     double now() const;
     void status(const std::string& what);
     void tick();
+    void timedTick(std::uint64_t expirations);  // tick(), its CPU time and the periods missed
     void restNow();  // the mouth to rest in real time (slew-limited steps, really waited for)
     void reload();
     void reportFailures();

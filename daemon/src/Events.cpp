@@ -59,6 +59,7 @@ json Daemon::Impl::statusReply() const {
             {"live_line", lineReply()},
             {"script", scriptReply()},
             {"latency", latency},
+            {"loop", loop.reply()},
             {"speaker", speakerReply()},
             // What clips hold: the one playing, and the queue (one made ready ahead at most).
             // (queue_bytes counts the live lines waiting to be learnt too.)

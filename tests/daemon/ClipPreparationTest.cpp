@@ -102,11 +102,18 @@ TEST(ClipPreparation, PreparingALongTextNeverStallsTheMouth) {
     c.sendLine(json{{"cmd", "say"}, {"text", text}}.dump());
     std::this_thread::sleep_for(1500ms);
     EXPECT_TRUE(json::parse(c.readLine())["ok"]);
+    // Nothing long ran on the loop while the worker prepared the text (about a second of
+    // espeak-ng's CPU): its busiest turn took well under a millisecond (CPU time, which a busy
+    // machine does not stretch).
+    const auto loop = c.request({{"cmd", "status"}})["loop"];
+    EXPECT_LT(loop["busiest_cpu_ms"].get<double>(), 50) << loop;
     EXPECT_EQ(d.stop(), 0);
     const auto jaw = d.recorded("jaw");
     ASSERT_GT(jaw.size(), 50u);
-    // The recorder gets a command every 10 ms tick; a stalled loop shows as a gap.
-    EXPECT_LT(longestGap(jaw), 0.25) << "the loop stalled while a clip was prepared";
+    // The recorder gets a command every 10 ms tick: a loop that waited for the worker would
+    // show as a gap of a second or more (a generous bound: on a busy machine the loop itself
+    // may wait a while for a core).
+    EXPECT_LT(longestGap(jaw), 1.0) << "the loop stalled while a clip was prepared";
 }
 
 TEST(ClipPreparation, ReloadKeepsWhatPlaysAndWhatWaitsAndAppendsTheRecord) {
@@ -130,11 +137,14 @@ TEST(ClipPreparation, ReloadKeepsWhatPlaysAndWhatWaitsAndAppendsTheRecord) {
     EXPECT_EQ(after["queue"], before["queue"]) << after;
     waitUntilIdle(c);
     EXPECT_EQ(c.request({{"cmd", "status"}})["played"], 2);
+    // The reload runs on the loop (about 25 ms of CPU, two ticks): its busiest turn.
+    const auto loop = c.request({{"cmd", "status"}})["loop"];
+    EXPECT_LT(loop["busiest_cpu_ms"].get<double>(), 250) << loop;
     EXPECT_EQ(d.stop(), 0);
     const auto jaw = d.recorded("jaw");
     ASSERT_FALSE(jaw.empty());
     EXPECT_LT(jaw.front().first, 0.5) << "the record lost what came before the reload";
-    EXPECT_LT(longestGap(jaw), 0.25) << "the mouth stopped across the reload";
+    EXPECT_LT(longestGap(jaw), 1.0) << "the mouth stopped across the reload";
 }
 
 }  // namespace
