@@ -47,12 +47,13 @@ Options parse(int argc, char** argv) {
     Options o;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        double* target = a == "--minutes" ? &o.minutes
-                         : a == "--every" ? &o.every
+        double* target = a == "--minutes"  ? &o.minutes
+                         : a == "--every"  ? &o.every
                          : a == "--report" ? &o.report
                                            : nullptr;
         if (!target || i + 1 == argc) {
-            std::fprintf(stderr, "usage: live_hour [--minutes 60] [--every SECONDS] [--report 10]\n");
+            std::fprintf(stderr,
+                         "usage: live_hour [--minutes 60] [--every SECONDS] [--report 10]\n");
             std::exit(2);
         }
         *target = std::atof(argv[++i]);

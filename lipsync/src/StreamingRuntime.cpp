@@ -85,8 +85,9 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
     // to come (pastKept()) where that is later: a pause heard live is one open segment that
     // grows as long as the pause lasts, and each tick's work and memory must not grow with it.
     const double windowStart = window_.empty() ? open->start : window_.front().start;
-    const auto firstFrame = static_cast<std::size_t>(std::max(
-        {0.0, std::ceil((windowStart - origin_) * rate - 1e-9), std::ceil((pastKept() - origin_) * rate - 1e-9)}));
+    const auto firstFrame =
+        static_cast<std::size_t>(std::max({0.0, std::ceil((windowStart - origin_) * rate - 1e-9),
+                                           std::ceil((pastKept() - origin_) * rate - 1e-9)}));
     // Work past the last frame to let out by a smoothing window, so that a curve cut short
     // there does not look like a peak to the valley smoothing.
     const double knownEnd = open ? open->end : window_.back().end;
