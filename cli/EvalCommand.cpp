@@ -374,7 +374,8 @@ nlohmann::json jawJson(const lipsync::JawScore& j) {
             {"closures", j.closures},
             {"closures_caught", j.closureRate()},
             {"open_frames", j.openFrames},
-            {"false_closures", j.falseClosureRate()}};
+            {"false_closures", j.falseClosureRate()},
+            {"opening_where_open", j.openingWhereOpen()}};
 }
 
 nlohmann::json boundaryJson(const dsp::BoundaryScore& b) {
@@ -488,6 +489,14 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
             << fixed2(report.total.jaw.labels.r()) << " from the labels (worst " << labels.first
             << ' ' << fixed2(labels.second) << "), envelope follower "
             << fixed2(report.total.jaw.envelope.r()) << '\n';
+        // A mouth can move at the right times and still too little: r cannot see that.
+        const auto opening =
+            worst(report, [](const Score& s) { return s.jaw.audio.openingWhereOpen(); });
+        out << "where the labels' mouth is clearly open, the jaw opens "
+            << fixed2(report.total.jaw.audio.openingWhereOpen()) << " of its travel"
+            << (o.align ? made : " from audio") << " (least: " << opening.first << ' '
+            << fixed2(opening.second) << "), " << fixed2(report.total.jaw.labels.openingWhereOpen())
+            << " from the labels\n";
     }
 }
 

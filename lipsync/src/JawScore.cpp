@@ -56,7 +56,7 @@ double JawScore::r() const {
 void JawScore::add(const JawScore& o) {
     n += o.n, sx += o.sx, sy += o.sy, sxx += o.sxx, syy += o.syy, sxy += o.sxy;
     closures += o.closures, closuresCaught += o.closuresCaught;
-    openFrames += o.openFrames, falseClosures += o.falseClosures;
+    openFrames += o.openFrames, falseClosures += o.falseClosures, openJaw += o.openJaw;
 }
 
 JawScore scoreJaw(std::span<const float> jaw, std::span<const float> reference,
@@ -69,6 +69,7 @@ JawScore scoreJaw(std::span<const float> jaw, std::span<const float> reference,
         s.n += 1, s.sx += x, s.sy += y, s.sxx += x * x, s.syy += y * y, s.sxy += x * y;
         if (y > config.clearlyOpenAbove) {
             ++s.openFrames;
+            s.openJaw += x;
             if (x < config.closedBelow) ++s.falseClosures;
         }
     }

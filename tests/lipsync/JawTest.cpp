@@ -182,6 +182,8 @@ TEST(JawScore, TheReferenceAgainstItselfIsPerfectAndAFrozenJawIsNot) {
     const std::vector<float> open(91, 0.6f), shut(91, 0.0f);
     EXPECT_EQ(lipsync::scoreJaw(open, ref, s, set, 100).closuresCaught, 0u);
     EXPECT_EQ(lipsync::scoreJaw(open, ref, s, set, 100).r(), 0.0);
+    EXPECT_NEAR(lipsync::scoreJaw(open, ref, s, set, 100).openingWhereOpen(), 0.6, 1e-6);
+    EXPECT_GT(self.openingWhereOpen(), 0.5);  // the reference itself, where it is above 0.5
     const auto closed = lipsync::scoreJaw(shut, ref, s, set, 100);
     EXPECT_GT(closed.openFrames, 10u);
     EXPECT_EQ(closed.falseClosureRate(), 1.0);

@@ -408,6 +408,11 @@ struct JawScore {
     // of them the jaw showed; frames where the reference is clearly open and how many of them
     // the jaw showed closed.
     std::size_t closures = 0, closuresCaught = 0, openFrames = 0, falseClosures = 0;
+    double openJaw = 0;  // the jaw summed over the clearly open frames
+
+    // How far the jaw opens, on average, where the reference is clearly open (0..1 of its
+    // travel): r cannot see a mouth that moves at the right times but too little.
+    double openingWhereOpen() const { return openFrames ? openJaw / double(openFrames) : 0.0; }
 
     double r() const;  // Pearson correlation of jaw and reference; 0 when either is constant
     double closureRate() const { return closures ? double(closuresCaught) / closures : 1.0; }
