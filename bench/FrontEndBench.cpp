@@ -8,12 +8,11 @@
 // their time per frame (one iteration = one frame, or one 10 ms block for the resampler).
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
-#include <unistd.h>
 
 #include <cmath>
-#include <fstream>
 #include <map>
 
+#include "ProcessUsage.hpp"
 #include "TestSpeech.hpp"
 
 namespace {
@@ -193,18 +192,11 @@ void Decode(benchmark::State& state) {
 }
 BENCHMARK(Decode);
 
-long residentKiB() {
-    std::ifstream statm("/proc/self/statm");
-    long pages = 0, resident = 0;
-    statm >> pages >> resident;
-    return resident * (sysconf(_SC_PAGESIZE) / 1024);
-}
-
 // One hour of 16 kHz audio streamed in 10 ms blocks: memory must stay flat (bounded buffers).
 void StreamOneHour(benchmark::State& state) {
     const auto& audio = speechAt(16000);
     const auto templates = dsp::TemplateSet::loadDefault();
-    const long before = residentKiB();
+    const long before = bench::residentKiB();
     std::size_t segments = 0;
     for (auto _ : state) {
         dsp::StreamingAnalyzer analyzer(templates, PhonemeSet::common(), 16000);
@@ -218,7 +210,7 @@ void StreamOneHour(benchmark::State& state) {
     }
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
-    state.counters["rss_growth_MiB"] = static_cast<double>(residentKiB() - before) / 1024;
+    state.counters["rss_growth_MiB"] = static_cast<double>(bench::residentKiB() - before) / 1024;
     state.counters["peak_rss_MiB"] = static_cast<double>(usage.ru_maxrss) / 1024;
     state.counters["segments"] = static_cast<double>(segments);
     state.counters["x_realtime"] =

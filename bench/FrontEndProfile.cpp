@@ -24,6 +24,7 @@
 
 #include "../dsp/src/FrameKernels.hpp"
 #include "../dsp/src/LpcSpectrum.hpp"
+#include "ProcessUsage.hpp"
 #include "TestSpeech.hpp"
 
 extern char** environ;
@@ -31,12 +32,6 @@ extern char** environ;
 namespace {
 
 using namespace lipsyncd;
-
-double cpuSeconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 // Peak resident set of this process, MiB.
 double peakRssMiB() {
@@ -88,9 +83,9 @@ class StageClock {
         : names_(std::move(names)), seconds_(names_.size(), 0.0) {}
     template <class F>
     void time(std::size_t stage, F&& f) {
-        const double t0 = cpuSeconds();
+        const double t0 = bench::threadCpuSeconds();
         f();
-        seconds_[stage] += cpuSeconds() - t0;
+        seconds_[stage] += bench::threadCpuSeconds() - t0;
     }
     void report(std::size_t frames) const {
         double total = 0;
@@ -283,9 +278,9 @@ int main(int argc, char** argv) {
         else if (arg == "--analyze") {  // child: analyse one file, report time and memory
             const auto templates = dsp::TemplateSet::loadDefault();
             const double before = peakRssMiB();
-            const double t0 = cpuSeconds();
+            const double t0 = bench::threadCpuSeconds();
             const auto result = dsp::analyzeFile(argv[i + 1], templates, PhonemeSet::common());
-            const double seconds = cpuSeconds() - t0;
+            const double seconds = bench::threadCpuSeconds() - t0;
             std::printf(
                 "  %6.1f min: %8.0f x real time, %6.3f s CPU, %zu segments; peak RSS "
                 "%.1f MiB (%.1f MiB before the analysis)\n",

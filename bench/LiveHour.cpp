@@ -10,34 +10,21 @@
 //   build/bench/live_hour [--minutes 60] [--every SECONDS] [--report 10]
 //
 // --every: the line again every this many seconds (a show), instead of once at the start.
-#include <time.h>
-#include <unistd.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <lipsyncd/daemon.hpp>
 #include <lipsyncd/dsp.hpp>
 #include <random>
 #include <string>
 
+#include "ProcessUsage.hpp"
+
 namespace {
 
 using namespace lipsyncd;
-
-double cpuSeconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-long residentKiB() {
-    std::ifstream statm("/proc/self/statm");
-    long pages = 0, resident = 0;
-    statm >> pages >> resident;
-    return resident * (sysconf(_SC_PAGESIZE) / 1024);
-}
+using bench::residentKiB;
+using bench::threadCpuSeconds;
 
 struct Options {
     double minutes = 60, every = 0, report = 10;  // every 0: the line once, at the start
@@ -91,7 +78,7 @@ int main(int argc, char** argv) {
         std::printf("every %.0f s, room noise between\n", o.every);
     else
         std::printf("once, then room noise\n");
-    double first = 0, stretch = 0, started = cpuSeconds();
+    double first = 0, stretch = 0, started = threadCpuSeconds();
     for (long tick = 0; tick < ticks; ++tick) {
         const auto at = static_cast<std::size_t>(tick % lineEvery) * block;
         for (std::size_t i = 0; i < block; ++i)
@@ -100,7 +87,7 @@ int main(int argc, char** argv) {
         out.values.clear();
         live->push(samples, out);
         if ((tick + 1) % reportEvery == 0 || tick + 1 == ticks) {
-            const double now = cpuSeconds();
+            const double now = threadCpuSeconds();
             const long n = (tick % reportEvery) + 1;
             stretch = 1e6 * (now - started) / static_cast<double>(n);
             if (first == 0) first = stretch;
