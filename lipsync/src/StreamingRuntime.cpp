@@ -124,8 +124,8 @@ void StreamingRuntime::emitUntil(double until, bool final, PoseTrack& out,
 void StreamingRuntime::buildSchedule(bool causal, const PhonemeSegment* open) {
     schedule_.assign(window_.begin(), window_.end());
     if (!causal) return;
-    // The typical length is the phonemes' heard: a pause says nothing about how long the next
-    // phoneme lasts, and a long one would stretch the guess over seconds.
+    // The typical length comes from the phonemes heard, not the pauses: a pause says nothing
+    // about how long the next phoneme lasts, and a long one would stretch the guess over seconds.
     double total = 0;
     std::size_t counted = 0;
     const auto& silence = (*phonemes_)[phonemes_->silence()].name;
