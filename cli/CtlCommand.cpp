@@ -1,5 +1,7 @@
 // lipsync ctl: the client of lipsyncd's control socket (JSON lines). Requests are built from the
 // daemon's command table and checked against it before they are sent; every wait has a deadline.
+#include <unistd.h>
+
 #include <chrono>
 #include <fstream>
 #include <iostream>
@@ -23,6 +25,9 @@ struct CtlOptions {
     int channel = -1;
     std::string voice, textFile;
     bool wait = false, next = false;
+    // The reply indented, a field a line (for a person), or on one line (for scripts); neither
+    // given: indented when standard output is a terminal.
+    bool pretty = false, oneLine = false;
     double timeout = 5;
 };
 
@@ -122,7 +127,8 @@ void runCtl(const CtlOptions& o) {
     daemon::ControlClient c(o.socket,
                             std::chrono::milliseconds(static_cast<long>(o.timeout * 1000)));
     const auto reply = c.request(request);
-    std::cout << reply.dump() << std::endl;
+    const bool pretty = o.pretty || (!o.oneLine && ::isatty(STDOUT_FILENO) == 1);
+    std::cout << reply.dump(pretty ? 2 : -1) << std::endl;
     if (!reply.value("ok", false))
         throw std::runtime_error("lipsyncd: " +
                                  reply.value("error", std::string("request refused")));
@@ -153,6 +159,12 @@ void addCtlCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0.05, 3600.0));
     cmd->add_flag("--wait", o->wait, "Return when nothing plays or is queued any more");
+    auto* pretty = cmd->add_flag("--pretty", o->pretty,
+                                 "Print the reply indented, a field a line (the default on a "
+                                 "terminal)");
+    cmd->add_flag("--one-line", o->oneLine,
+                  "Print the reply on one line (the default into a pipe or a file, for scripts)")
+        ->excludes(pretty);
     cmd->add_flag("--next", o->next, "line: cue the script's next line (loaded with `script`)");
     cmd->add_option("request", o->args, "The request and its arguments")->required();
     cmd->callback([o] { runCtl(*o); });

@@ -2,6 +2,7 @@
 // by the daemon and by `lipsync ctl`, and what the table does not know is refused by name.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <lipsyncd/daemon.hpp>
 
 #include "DaemonProcess.hpp"
@@ -53,6 +54,25 @@ TEST(CommandTable, CtlChecksItsRequestAgainstTheTableBeforeSending) {
     EXPECT_EQ(r.exitCode, 2) << r.err;
     const auto s = runLipsync({"ctl", "--socket", "/nonexistent/sock", "status", "extra"});
     EXPECT_EQ(s.exitCode, 2) << s.err;
+}
+
+// A reply for a person is indented, a field a line; into a pipe (scripts) it stays one line.
+TEST(CommandTable, CtlPrintsOneLineForScriptsAndIndentedWhenAsked) {
+    DaemonProcess d;
+    d.start();
+    ASSERT_TRUE(Client(d.socket()).connected());  // the daemon is up
+    const auto lines = [](const std::string& s) { return std::count(s.begin(), s.end(), '\n'); };
+    const auto piped = runLipsync({"ctl", "--socket", d.socket().string(), "status"});
+    ASSERT_EQ(piped.exitCode, 0) << piped.err;
+    EXPECT_EQ(lines(piped.out), 1) << piped.out;
+    const auto pretty = runLipsync({"ctl", "--socket", d.socket().string(), "status", "--pretty"});
+    ASSERT_EQ(pretty.exitCode, 0) << pretty.err;
+    EXPECT_GT(lines(pretty.out), 20) << pretty.out;
+    EXPECT_TRUE(json::parse(pretty.out)["ok"]) << pretty.out;
+    const auto both =
+        runLipsync({"ctl", "--socket", d.socket().string(), "status", "--pretty", "--one-line"});
+    EXPECT_EQ(both.exitCode, 2) << both.err;
+    EXPECT_EQ(d.stop(), 0);
 }
 
 // A socket that accepts and never answers: ctl gives up at its deadline, exit 1.
