@@ -11,6 +11,7 @@
 #include <lipsyncd/tts.hpp>
 
 #include "../../daemon/src/LiveMode.hpp"
+#include "../dsp/TestSpeech.hpp"
 #include "../support/AllocationCount.hpp"
 #include "DaemonProcess.hpp"
 
@@ -20,22 +21,18 @@ namespace {
 // Not in the training or dev corpus; a voice and a rate the templates were not trained on.
 const std::string kLine = "Seven puppets sang a song about the moon, and the moon sang back.";
 
-struct Spoken {
-    std::vector<float> samples;
-    int rate = 0;
-    PhonemeSchedule labels;
-};
+using Spoken = Speech;
 
 Spoken speak(EspeakSynthesizer& synth) {
-    const auto s = synth.synthesize({kLine, "en-us+f3", 150, -1});
+    const auto s = test::speak(synth, kLine, "en-us+f3", 150);
     Spoken out;
-    out.rate = s.sampleRate;
-    std::vector<float> pause(static_cast<std::size_t>(s.sampleRate / 2), 0.0f);
+    out.rate = s.rate;
+    std::vector<float> pause(static_cast<std::size_t>(s.rate / 2), 0.0f);
     out.samples = pause;  // the cue comes half a second before the line
-    for (auto v : s.samples) out.samples.push_back(v / 32768.0f);
+    out.samples.insert(out.samples.end(), s.samples.begin(), s.samples.end());
     out.samples.insert(out.samples.end(), pause.begin(), pause.end());
     out.labels.push_back({0.0, 0.5, "sil"});
-    for (auto p : mapSchedule(s.phonemes, espeakMapForVoice("en-us"), nullptr)) {
+    for (auto p : s.labels) {
         p.start += 0.5;
         p.end += 0.5;
         out.labels.push_back(p);

@@ -18,23 +18,14 @@ namespace {
 // Not in the training or dev corpus; a voice and rate the templates were not trained on.
 const std::string kLine = "Seven puppets sang a song about the moon.";
 
-struct Spoken {
-    std::vector<float> samples;
-    int rate = 0;
-    PhonemeSchedule labels;
-};
+using Spoken = test::Speech;
 
 EspeakSynthesizer& synth() {
     return test::espeak();
 }
 
 Spoken speak(const std::string& text, const std::string& voice = "en-us+f3", int wpm = 150) {
-    const auto s = synth().synthesize({text, voice, wpm, -1});
-    Spoken out;
-    out.rate = s.sampleRate;
-    for (auto v : s.samples) out.samples.push_back(v / 32768.0f);
-    out.labels = mapSchedule(s.phonemes, espeakMapForVoice(voice), nullptr);
-    return out;
+    return test::speak(synth(), text, voice, wpm);
 }
 
 dsp::AlignFileResult align(const std::filesystem::path& file, const std::string& text) {

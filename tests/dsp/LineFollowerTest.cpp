@@ -24,17 +24,17 @@ struct Spoken {
 };
 
 Spoken speak(const std::string& text, const std::string& name, double silenceBefore = 0) {
-    const auto s = test::espeak().synthesize({text, "en-us+f3", 150, -1});
-    std::vector<float> samples(static_cast<std::size_t>(silenceBefore * s.sampleRate), 0.0f);
-    for (auto v : s.samples) samples.push_back(v / 32768.0f);
+    const auto s = test::speak(test::espeak(), text, "en-us+f3", 150);
+    std::vector<float> samples(static_cast<std::size_t>(silenceBefore * s.rate), 0.0f);
+    samples.insert(samples.end(), s.samples.begin(), s.samples.end());
     Spoken out;
-    out.file = test::writeAudio(name, samples, s.sampleRate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
-    for (auto p : mapSchedule(s.phonemes, espeakMapForVoice("en-us"), nullptr)) {
+    out.file = test::writeAudio(name, samples, s.rate, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+    for (auto p : s.labels) {
         p.start += silenceBefore;
         p.end += silenceBefore;
         out.labels.push_back(p);
     }
-    out.seconds = static_cast<double>(samples.size()) / s.sampleRate;
+    out.seconds = static_cast<double>(samples.size()) / s.rate;
     return out;
 }
 

@@ -20,16 +20,22 @@ struct Speech {
     PhonemeSchedule labels;  // common set
 };
 
+// `text` said by espeak-ng's `voice` at `wpm` words a minute (0: the voice's own rate), with
+// espeak-ng's own timings as its labels.
+inline Speech speak(EspeakSynthesizer& synth, const std::string& text, const std::string& voice,
+                    int wpm = 0) {
+    const auto s = synth.synthesize({text, voice, wpm, -1});
+    Speech out;
+    out.rate = s.sampleRate;
+    out.samples.reserve(s.samples.size());
+    for (auto v : s.samples) out.samples.push_back(v / 32768.0f);
+    out.labels = mapSchedule(s.phonemes, espeakMapForVoice(voice), nullptr);
+    return out;
+}
+
 inline const Speech& testSpeech() {
-    static const Speech speech = [] {
-        const auto s = espeak().synthesize(
-            {"Hello puppet, please open your mouth wide and say something funny.", "en-us", 0, -1});
-        Speech out;
-        out.rate = s.sampleRate;
-        for (auto v : s.samples) out.samples.push_back(v / 32768.0f);
-        out.labels = mapSchedule(s.phonemes, PhonemeMap::named("espeak-en"), nullptr);
-        return out;
-    }();
+    static const Speech speech = speak(
+        espeak(), "Hello puppet, please open your mouth wide and say something funny.", "en-us");
     return speech;
 }
 
