@@ -342,12 +342,16 @@ void printRow(std::ostream& out, const std::string& first, const Score& s, bool 
     out << '\n';
 }
 
-void printConfusion(std::ostream& out, const dsp::ScheduleScore& total, const PhonemeSet& set) {
+// `jaw` (when scored): each class's mean jaw from the audio and from the labels, so that where
+// the opening is lost shows per phoneme, as recall shows where the schedule is.
+void printConfusion(std::ostream& out, const dsp::ScheduleScore& total, const PhonemeSet& set,
+                    const JawScores* jaw) {
     // "heard": frames decided as the class over frames labelled as it, so a class the front end
     // hears too often (a sink for other classes) or too rarely shows at once: what a template
     // set's class bias (scripts/fit-class-bias.py) corrects.
     out << "per class (reference): frames, recall, heard (frames decided as it / its frames), "
-           "most often taken for\n"
+        << (jaw ? "jaw (its mean over the class's frames: from audio, from the labels), " : "")
+        << "most often taken for\n"
         << std::fixed;
     for (std::size_t r = 0; r < set.size(); ++r) {
         std::size_t n = 0, decided = 0, worst = r;
@@ -360,8 +364,11 @@ void printConfusion(std::ostream& out, const dsp::ScheduleScore& total, const Ph
         if (n == 0) continue;
         out << "  " << std::left << std::setw(5) << set[r].name << std::right << std::setw(7) << n
             << std::setw(8) << std::setprecision(1) << 100.0 * total.confusion[r][r] / n << '%'
-            << std::setw(7) << std::setprecision(2) << static_cast<double>(decided) / n << "x"
-            << std::setprecision(1);
+            << std::setw(7) << std::setprecision(2) << static_cast<double>(decided) / n << "x";
+        if (jaw)
+            out << std::setw(7) << jaw->audio.meanJawOf(r) << std::setw(6)
+                << jaw->labels.meanJawOf(r);
+        out << std::setprecision(1);
         if (worst != r)
             out << "   " << set[worst].name << " (" << 100.0 * total.confusion[r][worst] / n
                 << "%)";
@@ -399,6 +406,17 @@ nlohmann::json scoreJson(const Score& s, const EvalOptions& o) {
     return j;
 }
 
+// Each labelled class's mean jaw, from the audio and from the labels (printConfusion's columns).
+nlohmann::json jawByClass(const JawScores& jaw, const PhonemeSet& set) {
+    auto j = nlohmann::json::object();
+    for (std::size_t c = 0; c < set.size(); ++c)
+        if (c < jaw.audio.classFrames.size() && jaw.audio.classFrames[c] > 0)
+            j[set[c].name] = {{"frames", jaw.audio.classFrames[c]},
+                              {"audio", jaw.audio.meanJawOf(c)},
+                              {"labels", jaw.labels.meanJawOf(c)}};
+    return j;
+}
+
 struct Report {
     std::vector<Row> files;
     std::map<std::string, Score> speakers;
@@ -414,7 +432,11 @@ nlohmann::json toJson(const Report& report, const PhonemeSet& set, const EvalOpt
         row["speaker"] = f.speaker;
         j["files"].push_back(row);
     }
-    for (const auto& [name, s] : report.speakers) j["speakers"][name] = scoreJson(s, o);
+    for (const auto& [name, s] : report.speakers) {
+        j["speakers"][name] = scoreJson(s, o);
+        if (o.jaw) j["speakers"][name]["jaw_by_class"] = jawByClass(s.jaw, set);
+    }
+    if (o.jaw) j["jaw_by_class"] = jawByClass(report.total.jaw, set);
     for (std::size_t r = 0; r < set.size(); ++r)
         for (std::size_t h = 0; h < set.size(); ++h)
             if (report.total.schedule.confusion[r][h] > 0)
@@ -467,7 +489,7 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
         for (const auto& f : report.files) printRow(out, f.speaker + "/" + f.name, f.score, o.jaw);
         out << '\n';
     }
-    printConfusion(out, report.total.schedule, set);
+    printConfusion(out, report.total.schedule, set, o.jaw ? &report.total.jaw : nullptr);
     out << '\n';
     printHeader(out, "speaker", o.jaw);
     for (const auto& [name, s] : report.speakers) printRow(out, name, s, o.jaw);

@@ -55,6 +55,12 @@ double JawScore::r() const {
 
 void JawScore::add(const JawScore& o) {
     n += o.n, sx += o.sx, sy += o.sy, sxx += o.sxx, syy += o.syy, sxy += o.sxy;
+    if (classJaw.size() < o.classJaw.size()) {
+        classJaw.resize(o.classJaw.size(), 0.0);
+        classFrames.resize(o.classJaw.size(), 0);
+    }
+    for (std::size_t c = 0; c < o.classJaw.size(); ++c)
+        classJaw[c] += o.classJaw[c], classFrames[c] += o.classFrames[c];
     closures += o.closures, closuresCaught += o.closuresCaught;
     openFrames += o.openFrames, falseClosures += o.falseClosures, openJaw += o.openJaw;
 }
@@ -72,6 +78,14 @@ JawScore scoreJaw(std::span<const float> jaw, std::span<const float> reference,
             s.openJaw += x;
             if (x < config.closedBelow) ++s.falseClosures;
         }
+    }
+    s.classJaw.assign(set.size(), 0.0);
+    s.classFrames.assign(set.size(), 0);
+    for (const auto& label : labels) {
+        const auto c = set.find(label.phoneme);
+        if (!c) continue;
+        for (auto f = frameAt(label.start, rate, frames); f < frameAt(label.end, rate, frames); ++f)
+            s.classJaw[*c] += jaw[f], ++s.classFrames[*c];
     }
     for (std::size_t i = 0; i < labels.size(); ++i) {
         if (!isClosure(labels, i, set)) continue;

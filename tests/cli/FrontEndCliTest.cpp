@@ -297,8 +297,15 @@ TEST(LipsyncCli, EvalScoresThePuppetsJawPerSpeaker) {
         EXPECT_GT(jaw["audio"]["r"].get<double>(), jaw["envelope"]["r"].get<double>() - 0.3);
         EXPECT_GE(jaw["labels"]["closures_caught"].get<double>(), 0.9);
         EXPECT_LE(jaw["labels"]["false_closures"].get<double>(), 0.05);
+        // Per class, the mean jaw: from the labels the open vowel opens, the bilabial shuts.
+        const auto& byClass = json["speakers"][speaker]["jaw_by_class"];
+        ASSERT_TRUE(byClass.contains("bmp") && byClass.contains("ah")) << byClass.dump();
+        EXPECT_GT(byClass["ah"]["labels"].get<double>(), 0.4) << speaker;
+        EXPECT_LT(byClass["bmp"]["labels"].get<double>(), 0.2) << speaker;
+        EXPECT_GT(byClass["ah"]["frames"].get<int>(), 0);
     }
     EXPECT_NE(r.out.find("jaw through 'jaw-servo'"), std::string::npos) << r.out;
+    EXPECT_NE(json["jaw_by_class"].dump(), "null");
     const auto floor = runLipsync({"eval", "--corpus", dir.string(), "--min-exact-jaw-r", "0.999"});
     EXPECT_EQ(floor.exitCode, 1);
     EXPECT_NE(floor.err.find("jaw r from the labels"), std::string::npos) << floor.err;

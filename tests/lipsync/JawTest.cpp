@@ -193,6 +193,30 @@ TEST(JawScore, TheReferenceAgainstItselfIsPerfectAndAFrozenJawIsNot) {
     EXPECT_EQ(twice.n, 2 * self.n);
 }
 
+// `lipsync eval`'s per-class jaw column: where a mouth opens too little shows per phoneme.
+TEST(JawScore, EachClassKeepsTheMeanJawOverItsLabelledFrames) {
+    const auto& set = PhonemeSet::common();
+    const PhonemeSchedule s{{0, 0.2, "sil", 1}, {0.2, 0.4, "aa", 1}, {0.4, 0.7, "eh", 1}};
+    const auto ref = lipsync::jawReference(s, set, 100, 71);
+    std::vector<float> jaw(71, 0.0f);
+    std::fill(jaw.begin() + 20, jaw.begin() + 30, 1.0f);  // the first half of aa only
+    std::fill(jaw.begin() + 40, jaw.begin() + 70, 0.3f);  // eh
+    const auto score = lipsync::scoreJaw(jaw, ref, s, set, 100);
+    const auto aa = *set.find("aa"), eh = *set.find("eh"), sil = set.silence();
+    EXPECT_EQ(score.classFrames[aa], 20u);
+    EXPECT_NEAR(score.meanJawOf(aa), 0.5, 1e-6);
+    EXPECT_NEAR(score.meanJawOf(eh), 0.3, 1e-6);
+    EXPECT_NEAR(score.meanJawOf(sil), 0.0, 1e-6);
+    EXPECT_EQ(score.meanJawOf(*set.find("ao")), 0.0);  // never labelled
+    auto sum = score;
+    sum.add(lipsync::scoreJaw(std::vector<float>(71, 1.0f), ref, s, set, 100));
+    EXPECT_EQ(sum.classFrames[aa], 40u);
+    EXPECT_NEAR(sum.meanJawOf(aa), 0.75, 1e-6);
+    lipsync::JawScore none;  // a speaker before any file: its sums grow to the set's classes
+    none.add(score);
+    EXPECT_NEAR(none.meanJawOf(eh), 0.3, 1e-6);
+}
+
 TEST(Jaw, APoseSetRejectsABadLoudnessGainAndRestRuleNamingTheLine) {
     const auto file = std::filesystem::temp_directory_path() / "lipsyncd-bad-poses.toml";
     for (const std::string body : {"[[pose]]\nname = \"jaw\"\nloudness_gain = 1.5\n",

@@ -409,10 +409,20 @@ struct JawScore {
     // the jaw showed closed.
     std::size_t closures = 0, closuresCaught = 0, openFrames = 0, falseClosures = 0;
     double openJaw = 0;  // the jaw summed over the clearly open frames
+    // Per class of the phoneme set (by index), over the frames labelled as it: the jaw summed
+    // and the frames. Empty until a frame is scored.
+    std::vector<double> classJaw;
+    std::vector<std::size_t> classFrames;
 
     // How far the jaw opens, on average, where the reference is clearly open (0..1 of its
     // travel): r cannot see a mouth that moves at the right times but too little.
     double openingWhereOpen() const { return openFrames ? openJaw / double(openFrames) : 0.0; }
+    // The mean jaw over the frames labelled as class `c` (0 without any): which phonemes the
+    // opening is lost on.
+    double meanJawOf(std::size_t c) const {
+        return c < classFrames.size() && classFrames[c] ? classJaw[c] / double(classFrames[c])
+                                                        : 0.0;
+    }
 
     double r() const;  // Pearson correlation of jaw and reference; 0 when either is constant
     double closureRate() const { return closures ? double(closuresCaught) / closures : 1.0; }
