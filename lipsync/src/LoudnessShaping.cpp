@@ -24,15 +24,34 @@ std::vector<double> gainsOf(const PoseSet& poses) {
     for (const auto& p : poses.poses()) g.push_back(p.loudnessGain);
     return g;
 }
+
+// The time whose level frame `t` is shaped by: t itself, or within `hold` before the silence
+// that follows t's segment, the time `hold` before that silence. `segment` walks forward with
+// t (the frames come in time order).
+double levelTimeFor(double t, std::span<const PhonemeSegment> schedule, const std::string& silence,
+                    double hold, std::size_t& segment) {
+    while (segment + 1 < schedule.size() && schedule[segment].end <= t) ++segment;
+    if (hold <= 0 || segment + 1 >= schedule.size()) return t;
+    const auto& next = schedule[segment + 1];
+    if (schedule[segment].phoneme == silence || next.phoneme != silence) return t;
+    return next.start - t < hold ? next.start - hold : t;
+}
 }  // namespace
 
-void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
-                     const LoudnessConfig& config) {
+void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels,
+                     std::span<const PhonemeSegment> schedule, const PhonemeSet& phonemes,
+                     PoseTrack& track, const LoudnessConfig& config) {
     if (levels.db.empty() || track.poses.size() != poses.size()) return;
     const auto gains = gainsOf(poses);
     const double reference = levels.speakingLevel(config.percentile, config.speechBelowPeakDb);
+    const auto& silence = phonemes[phonemes.silence()].name;
+    std::size_t segment = 0;
     for (std::size_t f = 0; f < track.frames(); ++f) {
-        const double s = relativeLevel(levels.at(track.times[f]), reference, config.rangeDb);
+        const double t = track.times[f];
+        const double held =
+            levelTimeFor(t, schedule, silence, config.fadeHoldSeconds, segment);
+        const double s = std::max(relativeLevel(levels.at(t), reference, config.rangeDb),
+                                  relativeLevel(levels.at(held), reference, config.rangeDb));
         scaleFrame(gains, s,
                    std::span<float>(track.values).subspan(f * poses.size(), poses.size()));
     }

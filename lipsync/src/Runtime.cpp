@@ -41,7 +41,7 @@ PoseTrack Runtime::animate(std::span<const PhonemeSegment> schedule,
                      ? animateFilter(schedule, curves_, poses_, spec_.config, *phonemes_)
                      : lipsync::animate(schedule, curves_, poses_, spec_.config, *phonemes_);
     if (levels && spec_.heardJaw) blendHeardJaw(poses_, *levels, track);
-    if (levels && spec_.loudness) shapeByLoudness(poses_, *levels, track);
+    if (levels && spec_.loudness) shapeByLoudness(poses_, *levels, schedule, *phonemes_, track);
     return track;
 }
 

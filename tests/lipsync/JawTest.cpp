@@ -144,7 +144,7 @@ TEST(Jaw, LouderSpeechOpensWiderButNeverPastThePhonemesOpening) {
     for (std::size_t f = 50; f <= 80; ++f) levels.db[f] = -38.0f;  // the second vowel quiet
     for (std::size_t f = 40; f < 50; ++f) levels.db[f] = 0.0f;     // a very loud m
     auto shaped = plain;
-    lipsync::shapeByLoudness(shipped().poses, levels, shaped);
+    lipsync::shapeByLoudness(shipped().poses, levels, s, PhonemeSet::common(), shaped);
     const auto jaw = shipped().jaw;
     for (std::size_t i = 0; i < plain.values.size(); ++i)
         ASSERT_LE(shaped.values[i], plain.values[i] + 1e-6f);
@@ -152,6 +152,35 @@ TEST(Jaw, LouderSpeechOpensWiderButNeverPastThePhonemesOpening) {
     const double gain = shipped().poses[jaw].loudnessGain;
     EXPECT_NEAR(weightAt(shaped, 0.65, jaw), (1 - gain) * weightAt(plain, 0.65, jaw), 0.01);
     EXPECT_LT(weightAt(shaped, 0.45, jaw), 0.05f);  // the nasal stays closed however loud
+}
+
+// A word's sound fades before its pause while the mouth still holds the vowel: the fade must not
+// shut the mouth early (the rest ramp closes it once the pause starts). The same fade inside
+// speech, with no pause after it, is quieter speech and narrows the mouth as before.
+TEST(Jaw, TheFadeBeforeAPauseDoesNotShutTheMouthButQuietSpeechStillNarrowsIt) {
+    const PhonemeSchedule beforePause{{0, 0.1, "sil", 1}, {0.1, 0.5, "aa", 1}, {0.5, 0.8, "sil", 1}};
+    const PhonemeSchedule inSpeech{
+        {0, 0.1, "sil", 1}, {0.1, 0.5, "aa", 1}, {0.5, 0.8, "ah", 1}, {0.8, 1.0, "sil", 1}};
+    LevelTrack levels;
+    levels.db.assign(101, -20.0f);                                 // speaking level
+    for (std::size_t f = 44; f < 50; ++f) levels.db[f] = -45.0f;  // the last 60 ms fade out
+    const auto jaw = shipped().jaw;
+    const double gain = shipped().poses[jaw].loudnessGain;
+    const auto shaped = [&](const PhonemeSchedule& s, double hold) {
+        auto track = lipsync::animate(s, shipped().curves, shipped().poses);
+        const auto plain = track;
+        lipsync::LoudnessConfig config;
+        config.fadeHoldSeconds = hold;
+        lipsync::shapeByLoudness(shipped().poses, levels, s, PhonemeSet::common(), track, config);
+        return std::pair(weightAt(plain, 0.47, jaw), weightAt(track, 0.47, jaw));
+    };
+    const auto [plain, held] = shaped(beforePause, 0.1);
+    ASSERT_GT(plain, 0.3f);
+    EXPECT_NEAR(held, plain, 1e-4);  // the vowel's last frames keep its opening
+    const auto [plain0, faded] = shaped(beforePause, 0);
+    EXPECT_NEAR(faded, (1 - gain) * plain0, 0.01);  // without the hold: shut by the fade
+    const auto [plainInSpeech, quiet] = shaped(inSpeech, 0.1);
+    EXPECT_NEAR(quiet, (1 - gain) * plainInSpeech, 0.01);  // no pause after it: quieter speech
 }
 
 TEST(Jaw, TheStreamingShaperFollowsADecayingPeak) {

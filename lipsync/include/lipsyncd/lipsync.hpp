@@ -241,10 +241,20 @@ struct LoudnessConfig {
     double percentile = 0.9;        // offline: L is this percentile of the speech frames' levels
     double speechBelowPeakDb = 40;  // frames this far below the loudest are not speech
     double peakDecayDbPerS = 3;     // streaming: L is a peak that decays this fast
+    // Offline: over the last fadeHoldSeconds before a silence, s stays at least what it was that
+    // long before it. A word's sound fades while the mouth still holds its last phoneme, and
+    // the rest ramp (restInPauses) closes it once the silence starts; read as quieter speech,
+    // the fade had shut the mouth early. Chosen on the tune voices (docs/measurements.md,
+    // "Where the jaw's opening is lost, by phoneme"): 0.05 / 0.08 / 0.1 / 0.15 / 0.3 s gave
+    // false closures 50.7 → 49.4 / 49.1 / 48.9 / 49.2 / 49.0 summed, closures caught and jaw r
+    // level; 0: none. The live stream cannot know a silence is coming, and does not hold.
+    double fadeHoldSeconds = 0.1;
 };
-// Offline: L from the whole utterance. `levels` are frame RMS in dBFS (dsp::measureLevels).
-void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
-                     const LoudnessConfig& config = {});
+// Offline: L from the whole utterance. `levels` are frame RMS in dBFS (dsp::measureLevels);
+// `schedule` (the phonemes the track was made from) says where silences start.
+void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels,
+                     std::span<const PhonemeSegment> schedule, const PhonemeSet& phonemes,
+                     PoseTrack& track, const LoudnessConfig& config = {});
 // The jaw the front end heard (LevelTrack::jaw: per frame, the jaw height its class scores point
 // to, smoothed over `smoothingSeconds`) blended into each pose with a heard_jaw share g:
 // w' = (1 − g)·w + g·heard (g: heard_jaw, or heard_jaw_aligned for a track of aligned speech).
