@@ -246,8 +246,9 @@ struct LoudnessConfig {
     // the rest ramp (restInPauses) closes it once the silence starts; read as quieter speech,
     // the fade had shut the mouth early. Chosen on the tune voices (docs/measurements.md,
     // "Where the jaw's opening is lost, by phoneme"): 0.05 / 0.08 / 0.1 / 0.15 / 0.3 s gave
-    // false closures 50.7 → 49.4 / 49.1 / 48.9 / 49.2 / 49.0 summed, closures caught and jaw r
-    // level; 0: none. The live stream cannot know a silence is coming, and does not hold.
+    // false closures 50.7 → 49.4 / 49.0 / 48.9 / 49.1 / 49.0 summed, closures caught and jaw r
+    // level (r falls from 0.2 s on); 0: none. The live stream cannot know a silence is coming,
+    // and does not hold.
     double fadeHoldSeconds = 0.1;
 };
 // Offline: L from the whole utterance. `levels` are frame RMS in dBFS (dsp::measureLevels);
