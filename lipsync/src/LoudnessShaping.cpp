@@ -48,8 +48,7 @@ void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels,
     std::size_t segment = 0;
     for (std::size_t f = 0; f < track.frames(); ++f) {
         const double t = track.times[f];
-        const double held =
-            levelTimeFor(t, schedule, silence, config.fadeHoldSeconds, segment);
+        const double held = levelTimeFor(t, schedule, silence, config.fadeHoldSeconds, segment);
         const double s = std::max(relativeLevel(levels.at(t), reference, config.rangeDb),
                                   relativeLevel(levels.at(held), reference, config.rangeDb));
         scaleFrame(gains, s,

@@ -158,11 +158,12 @@ TEST(Jaw, LouderSpeechOpensWiderButNeverPastThePhonemesOpening) {
 // shut the mouth early (the rest ramp closes it once the pause starts). The same fade inside
 // speech, with no pause after it, is quieter speech and narrows the mouth as before.
 TEST(Jaw, TheFadeBeforeAPauseDoesNotShutTheMouthButQuietSpeechStillNarrowsIt) {
-    const PhonemeSchedule beforePause{{0, 0.1, "sil", 1}, {0.1, 0.5, "aa", 1}, {0.5, 0.8, "sil", 1}};
+    const PhonemeSchedule beforePause{
+        {0, 0.1, "sil", 1}, {0.1, 0.5, "aa", 1}, {0.5, 0.8, "sil", 1}};
     const PhonemeSchedule inSpeech{
         {0, 0.1, "sil", 1}, {0.1, 0.5, "aa", 1}, {0.5, 0.8, "ah", 1}, {0.8, 1.0, "sil", 1}};
     LevelTrack levels;
-    levels.db.assign(101, -20.0f);                                 // speaking level
+    levels.db.assign(101, -20.0f);                                // speaking level
     for (std::size_t f = 44; f < 50; ++f) levels.db[f] = -45.0f;  // the last 60 ms fade out
     const auto jaw = shipped().jaw;
     const double gain = shipped().poses[jaw].loudnessGain;
