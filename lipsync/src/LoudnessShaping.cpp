@@ -25,16 +25,26 @@ std::vector<double> gainsOf(const PoseSet& poses) {
     return g;
 }
 
-// The time whose level frame `t` is shaped by: t itself, or within `hold` before the silence
-// that follows t's segment, the time `hold` before that silence. `segment` walks forward with
-// t (the frames come in time order).
+// Where the schedule's pauses start: each silence that follows speech.
+std::vector<double> pauseStarts(std::span<const PhonemeSegment> schedule,
+                                const std::string& silence) {
+    std::vector<double> starts;
+    for (std::size_t i = 1; i < schedule.size(); ++i)
+        if (schedule[i].phoneme == silence && schedule[i - 1].phoneme != silence)
+            starts.push_back(schedule[i].start);
+    return starts;
+}
+
+// The time whose level shapes the frame at `t`: t itself, or, for speech within `hold` of the
+// next pause, the time `hold` before that pause. `next` (the first pause not yet passed) and
+// `segment` (the one holding t) walk forward with t: the frames come in time order.
 double levelTimeFor(double t, std::span<const PhonemeSegment> schedule, const std::string& silence,
-                    double hold, std::size_t& segment) {
+                    std::span<const double> pauses, double hold, std::size_t& segment,
+                    std::size_t& next) {
     while (segment + 1 < schedule.size() && schedule[segment].end <= t) ++segment;
-    if (hold <= 0 || segment + 1 >= schedule.size()) return t;
-    const auto& next = schedule[segment + 1];
-    if (schedule[segment].phoneme == silence || next.phoneme != silence) return t;
-    return next.start - t < hold ? next.start - hold : t;
+    while (next < pauses.size() && pauses[next] <= t) ++next;
+    if (hold <= 0 || next == pauses.size() || schedule[segment].phoneme == silence) return t;
+    return pauses[next] - t < hold ? pauses[next] - hold : t;
 }
 }  // namespace
 
@@ -45,10 +55,12 @@ void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels,
     const auto gains = gainsOf(poses);
     const double reference = levels.speakingLevel(config.percentile, config.speechBelowPeakDb);
     const auto& silence = phonemes[phonemes.silence()].name;
-    std::size_t segment = 0;
+    const auto pauses = pauseStarts(schedule, silence);
+    std::size_t segment = 0, next = 0;
     for (std::size_t f = 0; f < track.frames(); ++f) {
         const double t = track.times[f];
-        const double held = levelTimeFor(t, schedule, silence, config.fadeHoldSeconds, segment);
+        const double held =
+            levelTimeFor(t, schedule, silence, pauses, config.fadeHoldSeconds, segment, next);
         const double s = std::max(relativeLevel(levels.at(t), reference, config.rangeDb),
                                   relativeLevel(levels.at(held), reference, config.rangeDb));
         scaleFrame(gains, s,

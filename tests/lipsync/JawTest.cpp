@@ -182,6 +182,12 @@ TEST(Jaw, TheFadeBeforeAPauseDoesNotShutTheMouthButQuietSpeechStillNarrowsIt) {
     EXPECT_NEAR(faded, (1 - gain) * plain0, 0.01);  // without the hold: shut by the fade
     const auto [plainInSpeech, quiet] = shaped(inSpeech, 0.1);
     EXPECT_NEAR(quiet, (1 - gain) * plainInSpeech, 0.01);  // no pause after it: quieter speech
+    // The hold covers the last 0.1 s of speech whichever phonemes it holds: here 0.47 s lies in
+    // the vowel before a short last one.
+    const PhonemeSchedule shortLast{
+        {0, 0.1, "sil", 1}, {0.1, 0.48, "aa", 1}, {0.48, 0.5, "ah", 1}, {0.5, 0.8, "sil", 1}};
+    const auto [plainShort, heldShort] = shaped(shortLast, 0.1);
+    EXPECT_NEAR(heldShort, plainShort, 1e-4);
 }
 
 TEST(Jaw, TheStreamingShaperFollowsADecayingPeak) {

@@ -241,14 +241,15 @@ struct LoudnessConfig {
     double percentile = 0.9;        // offline: L is this percentile of the speech frames' levels
     double speechBelowPeakDb = 40;  // frames this far below the loudest are not speech
     double peakDecayDbPerS = 3;     // streaming: L is a peak that decays this fast
-    // Offline: over the last fadeHoldSeconds before a silence, s stays at least what it was that
-    // long before it. A word's sound fades while the mouth still holds its last phoneme, and
-    // the rest ramp (restInPauses) closes it once the silence starts; read as quieter speech,
-    // the fade had shut the mouth early. Chosen on the tune voices (docs/measurements.md,
-    // "Where the jaw's opening is lost, by phoneme"): 0.05 / 0.08 / 0.1 / 0.15 / 0.3 s gave
-    // false closures 50.7 → 49.4 / 49.0 / 48.9 / 49.1 / 49.0 summed, closures caught and jaw r
-    // level (r falls from 0.2 s on); 0: none. The live stream cannot know a silence is coming,
-    // and does not hold.
+    // Offline: speech within fadeHoldSeconds of a pause is shaped by the level at least as loud
+    // as fadeHoldSeconds before the pause. A word's sound fades while the mouth still holds its
+    // last phoneme, and the rest ramp (restInPauses) closes it once the pause starts; read as
+    // quieter speech, the fade had shut the mouth early. Chosen on the tune voices
+    // (docs/measurements.md, "Where the jaw's opening is lost, by phoneme"): 0.05 / 0.08 / 0.1 /
+    // 0.12 / 0.15 / 0.2 s gave false closures 50.7 → 49.3 / 48.9 / 48.9 / 48.9 / 48.9 / 48.9
+    // summed, jaw r 3.902 → 3.906 / 3.908 / 3.908 / 3.908 / 3.907 / 3.904, closures caught 355.2
+    // → 355.1 up to 0.1 s, then falling (351.8 at 0.2 s); 0: none. The live stream cannot know a
+    // pause is coming, and does not hold.
     double fadeHoldSeconds = 0.1;
 };
 // Offline: L from the whole utterance. `levels` are frame RMS in dBFS (dsp::measureLevels);
