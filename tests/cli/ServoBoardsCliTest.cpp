@@ -4,6 +4,7 @@
 // rest; `lipsync devices` lists buses, ports and chips.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <stdlib.h>
 
 #include <algorithm>
@@ -55,13 +56,18 @@ TEST(ServoBoardsCli, DriveSendsMaestroTargetsToAPseudoTerminalEndingAtRest) {
     const auto r = runLipsync({"drive", "--weights", (dir / "w.csv").string(), "--puppet",
                                (dir / "maestro.toml").string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    fcntl(master, F_SETFL, O_NONBLOCK);
-    std::vector<unsigned char> bytes(65536);
-    const ssize_t n = ::read(master, bytes.data(), bytes.size());
+    // A pty hands the bytes over in chunks, some after the writer has exited: read until
+    // nothing more arrives for half a second, not once (a single read lost the rest in CI).
+    std::vector<unsigned char> bytes;
+    for (pollfd p{master, POLLIN, 0}; ::poll(&p, 1, 500) > 0;) {
+        unsigned char chunk[4096];
+        const ssize_t got = ::read(master, chunk, sizeof chunk);
+        if (got <= 0) break;
+        bytes.insert(bytes.end(), chunk, chunk + got);
+    }
     ::close(keep);
     ::close(master);
-    ASSERT_GT(n, 8);
-    bytes.resize(static_cast<std::size_t>(n));
+    ASSERT_GT(bytes.size(), 8u);
     ASSERT_EQ(bytes.size() % 4, 0u);  // compact protocol: 4 bytes a command, nothing else
     EXPECT_EQ(bytes[0], 0x87);        // speed limit first, then acceleration
     EXPECT_EQ(bytes[4], 0x89);
