@@ -103,6 +103,10 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
         if (!(p.heardJawAligned >= 0 && p.heardJawAligned <= 1))
             t.fail("heard_jaw_aligned", "must be in [0, 1]");
         p.heardJawClosedBy = t.optString("heard_jaw_closed_by").value_or("");
+        p.dipDepth = t.optNumber("dip_depth").value_or(0);
+        if (!(p.dipDepth >= 0 && p.dipDepth <= 1)) t.fail("dip_depth", "must be in [0, 1]");
+        p.dipRise = t.optNumber("dip_rise").value_or(p.dipRise);
+        if (!(p.dipRise > 0 && p.dipRise <= 1)) t.fail("dip_rise", "must be in (0, 1]");
         t.finish();
         poses.push_back(std::move(p));
     }

@@ -42,6 +42,10 @@ PoseTrack Runtime::animate(std::span<const PhonemeSegment> schedule,
                      : lipsync::animate(schedule, curves_, poses_, spec_.config, *phonemes_);
     if (levels && spec_.heardJaw) blendHeardJaw(poses_, *levels, track);
     if (levels && spec_.loudness) shapeByLoudness(poses_, *levels, schedule, *phonemes_, track);
+    // The heard jaw's 40 ms smoothing fills the dips between syllables: deepened where it set
+    // most of the jaw, speech analysed from audio alone (known phonemes dip in their curves).
+    if (levels && spec_.heardJaw && !levels->jaw.empty() && !levels->aligned)
+        deepenDips(poses_, track);
     return track;
 }
 

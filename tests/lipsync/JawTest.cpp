@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 #include <random>
 
 #include "RuntimeTestSupport.hpp"
@@ -190,6 +191,79 @@ TEST(Jaw, TheFadeBeforeAPauseDoesNotShutTheMouthButQuietSpeechStillNarrowsIt) {
     EXPECT_NEAR(heldShort, plainShort, 1e-4);
 }
 
+// A jaw track of the shipped poses, 100 frames a second, the jaw following `jaw(t)` and every
+// other pose at 0.3.
+template <class Jaw>
+PoseTrack jawTrack(std::size_t frames, Jaw jaw) {
+    PoseTrack track;
+    for (const auto& p : shipped().poses.poses()) track.poses.push_back(p.name);
+    std::vector<float> w(track.poses.size(), 0.3f);
+    for (std::size_t f = 0; f < frames; ++f) {
+        w[shipped().jaw] = jaw(f);
+        track.append(double(f) / 100, w);
+    }
+    return track;
+}
+
+TEST(Jaw, ASyllablesDipClosesTheJawButAWobbleOrAFallIntoAPauseDoesNot) {
+    const auto& jawPose = shipped().poses[shipped().jaw];
+    ASSERT_GT(jawPose.dipDepth, 0);
+    // Two vowels at 0.6 with a consonant between them: the heard jaw dips to 0.3 at 0.2 s.
+    const auto dip = [](std::size_t f) {
+        return 0.6f - 0.3f * std::max(0.0f, 1 - std::abs(float(f) - 20) / 4);
+    };
+    auto track = jawTrack(40, dip);
+    lipsync::deepenDips(shipped().poses, track);
+    EXPECT_NEAR(weightAt(track, 0.2, shipped().jaw), 0.3 * (1 - jawPose.dipDepth), 1e-5);
+    EXPECT_LT(weightAt(track, 0.19, shipped().jaw), dip(19));  // less beside it
+    EXPECT_GT(weightAt(track, 0.19, shipped().jaw), dip(19) * (1 - jawPose.dipDepth));
+    EXPECT_FLOAT_EQ(weightAt(track, 0.23, shipped().jaw), dip(23));  // the vowels keep theirs
+    for (std::size_t f = 0; f < track.frames(); ++f)                 // and the other poses theirs
+        EXPECT_FLOAT_EQ(track.frame(f)[shipped().jaw == 0 ? 1 : 0], 0.3f);
+
+    // A wobble smaller than dip_rise, and a fall into a pause (no rise after it), stay.
+    const float wobble = float(jawPose.dipRise) * 0.6f;
+    for (const auto& curve : std::vector<std::function<float(std::size_t)>>{
+             [&](std::size_t f) { return 0.5f - (f == 20 ? wobble : 0.0f); },
+             [](std::size_t f) { return f < 20 ? 0.6f : std::max(0.0f, 0.6f - 0.1f * (f - 20)); },
+         }) {
+        auto flat = jawTrack(40, curve);
+        const auto before = flat.values;
+        lipsync::deepenDips(shipped().poses, flat);
+        EXPECT_EQ(flat.values, before);
+    }
+}
+
+TEST(Jaw, OnlyTheJawHeardFromAudioAloneHasItsDipsDeepened) {
+    const lipsync::Runtime runtime{lipsync::RuntimeSpec{}};
+    const PhonemeSchedule s{{0, 0.1, "sil", 1},
+                            {0.1, 0.3, "aa", 1},
+                            {0.3, 0.34, "d", 1},
+                            {0.34, 0.6, "aa", 1},
+                            {0.6, 0.9, "sil", 1}};
+    LevelTrack levels;
+    levels.db.assign(91, -20.0f);
+    for (std::size_t f = 0; f <= 90; ++f)  // heard: open, with a shallow dip at the /d/
+        levels.jaw.push_back(f < 10 || f >= 60 ? 0.0f : (f >= 30 && f < 34 ? 0.45f : 0.7f));
+    const auto jaw = shipped().jaw;
+    // The runtime's steps before the dips, by hand.
+    const auto undeepened = [&] {
+        auto track = lipsync::animate(s, shipped().curves, shipped().poses);
+        lipsync::blendHeardJaw(shipped().poses, levels, track);
+        lipsync::shapeByLoudness(shipped().poses, levels, s, PhonemeSet::common(), track);
+        return track;
+    };
+    const auto lowest = [&](const PoseTrack& t) {
+        float m = 1;
+        for (int f = 28; f <= 36; ++f) m = std::min(m, t.frame(std::size_t(f))[jaw]);
+        return m;
+    };
+    const auto audio = runtime.animate(s, &levels);
+    EXPECT_LT(lowest(audio), 0.8f * lowest(undeepened()));
+    levels.aligned = true;
+    EXPECT_EQ(runtime.animate(s, &levels).values, undeepened().values);
+}
+
 TEST(Jaw, TheStreamingShaperFollowsADecayingPeak) {
     lipsync::LoudnessShaper shaper(shipped().poses);
     std::vector<float> w(shipped().poses.size(), 1.0f);
@@ -253,10 +327,12 @@ TEST(JawScore, EachClassKeepsTheMeanJawOverItsLabelledFrames) {
     EXPECT_NEAR(none.meanJawOf(eh), 0.3, 1e-6);
 }
 
-TEST(Jaw, APoseSetRejectsABadLoudnessGainAndRestRuleNamingTheLine) {
+TEST(Jaw, APoseSetRejectsABadLoudnessGainRestRuleOrDipNamingTheLine) {
     const auto file = std::filesystem::temp_directory_path() / "lipsyncd-bad-poses.toml";
     for (const std::string body : {"[[pose]]\nname = \"jaw\"\nloudness_gain = 1.5\n",
-                                   "[[pose]]\nname = \"jaw\"\n[rest]\nwithin = -1\n"}) {
+                                   "[[pose]]\nname = \"jaw\"\n[rest]\nwithin = -1\n",
+                                   "[[pose]]\nname = \"jaw\"\ndip_depth = 1.5\n",
+                                   "[[pose]]\nname = \"jaw\"\ndip_rise = 0\n"}) {
         std::ofstream(file) << "name = \"bad\"\n" << body;
         try {
             lipsync::PoseSet::load(file);

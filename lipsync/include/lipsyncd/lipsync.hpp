@@ -46,6 +46,10 @@ struct Pose {
     // A pose (the lips' closure) whose weight w holds the heard jaw back to (1 − w) of its share:
     // a closure the schedule places stays closed. Empty: none.
     std::string heardJawClosedBy;
+    // Offline, on speech analysed from audio alone: a clear dip (the weight rising by dipRise
+    // on both sides) is lowered by dipDepth at its lowest point (deepenDips). 0: none.
+    double dipDepth = 0;
+    double dipRise = 0.15;
 };
 
 // The mouth rests when speech stops: from the start of a silence at least `minPause` long (and
@@ -257,6 +261,18 @@ struct LoudnessConfig {
 void shapeByLoudness(const PoseSet& poses, const LevelTrack& levels,
                      std::span<const PhonemeSegment> schedule, const PhonemeSet& phonemes,
                      PoseTrack& track, const LoudnessConfig& config = {});
+// A syllable closes the jaw: each clear dip of a pose with a dip_depth (its lowest point within
+// ±lowestWithin, the weight rising by the pose's dip_rise within riseWithin on both sides) is
+// lowered by dip_depth at its lowest frame, tapering to nothing at ±(taper + one frame).
+// Offline only (riseWithin of lookahead). The runtime runs it on speech analysed from audio
+// alone, whose jaw the heard jaw's smoothing sets; aligned speech's curves dip at its known
+// consonants, and a deeper dip there only cost jaw r and false closures (measured).
+struct DipConfig {
+    double lowestWithin = 0.03;
+    double riseWithin = 0.06;
+    double taper = 0.01;
+};
+void deepenDips(const PoseSet& poses, PoseTrack& track, const DipConfig& config = {});
 // The jaw the front end heard (LevelTrack::jaw: per frame, the jaw height its class scores point
 // to, smoothed over `smoothingSeconds`) blended into each pose with a heard_jaw share g:
 // w' = (1 − g)·w + g·heard (g: heard_jaw, or heard_jaw_aligned for a track of aligned speech).
