@@ -22,18 +22,31 @@ double heardAt(const LevelTrack& levels, double t, double half) {
     for (long i = from; i <= to; ++i) sum += levels.jaw[static_cast<std::size_t>(i)];
     return sum / static_cast<double>(to - from + 1);
 }
+
+// How much of a closure the schedule places holds the heard jaw back: all of it, but from audio
+// alone, offline, less where the heard jaw is open. There the schedule's bilabial is a guess
+// the ear contradicts (in vowels, most false closures were such bilabials), and the jaw's dips
+// close the mouth between syllables (deepenDips).
+double closureHeld(const Pose& pose, double heard, HeardSpeech speech) {
+    if (speech != HeardSpeech::analysed || heard <= pose.closureHeldBelow) return 1;
+    if (heard >= pose.closureDoubtedAbove) return 0;
+    return (pose.closureDoubtedAbove - heard) / (pose.closureDoubtedAbove - pose.closureHeldBelow);
+}
 }  // namespace
 
-void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights, bool aligned) {
+void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights,
+                   HeardSpeech speech) {
     heard = std::isfinite(heard) ? std::clamp(heard, 0.0, 1.0) : 0.0;
     for (std::size_t p = 0; p < poses.size(); ++p) {
         const auto& pose = poses.poses()[p];
-        const double g = aligned ? pose.heardJawAligned : pose.heardJaw;
+        const double g = speech == HeardSpeech::aligned ? pose.heardJawAligned : pose.heardJaw;
         if (g <= 0) continue;
         // Where the schedule closes the lips, the heard height gives way: a bilabial the
         // schedule places stays a closure.
         const auto closer = poses.find(pose.heardJawClosedBy);
-        const double closed = closer ? std::clamp<double>(weights[*closer], 0.0, 1.0) : 0.0;
+        const double closed = closer ? std::clamp<double>(weights[*closer], 0.0, 1.0) *
+                                           closureHeld(pose, heard, speech)
+                                     : 0.0;
         weights[p] = static_cast<float>((1 - g) * weights[p] + g * heard * (1 - closed));
     }
 }
@@ -44,7 +57,7 @@ void blendHeardJaw(const PoseSet& poses, const LevelTrack& levels, PoseTrack& tr
     for (std::size_t f = 0; f < track.frames(); ++f)
         blendHeardJaw(poses, heardAt(levels, track.times[f], smoothingSeconds / 2),
                       std::span<float>(track.values).subspan(f * poses.size(), poses.size()),
-                      levels.aligned);
+                      levels.aligned ? HeardSpeech::aligned : HeardSpeech::analysed);
 }
 
 }  // namespace lipsyncd::lipsync

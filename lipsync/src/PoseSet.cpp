@@ -103,6 +103,12 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
         if (!(p.heardJawAligned >= 0 && p.heardJawAligned <= 1))
             t.fail("heard_jaw_aligned", "must be in [0, 1]");
         p.heardJawClosedBy = t.optString("heard_jaw_closed_by").value_or("");
+        if (const auto doubt = t.optNumberArray("heard_jaw_doubts_closure")) {
+            const auto& d = *doubt;
+            if (d.size() != 2 || !(d[0] >= 0 && d[0] < d[1] && d[1] <= 1))
+                t.fail("heard_jaw_doubts_closure", "must be [from, to] with 0 <= from < to <= 1");
+            p.closureHeldBelow = d[0], p.closureDoubtedAbove = d[1];
+        }
         p.dipDepth = t.optNumber("dip_depth").value_or(0);
         if (!(p.dipDepth >= 0 && p.dipDepth <= 1)) t.fail("dip_depth", "must be in [0, 1]");
         p.dipRise = t.optNumber("dip_rise").value_or(p.dipRise);

@@ -67,7 +67,7 @@ TEST(HeardJaw, SpeechAlignedOnItsWordsTakesTheAlignedShare) {
     EXPECT_NEAR(analysed.frame(0)[0], 0.2 * 0.5 + 0.8 * 1.0, 1e-5);
     EXPECT_NEAR(aligned.frame(0)[0], 0.6 * 0.5 + 0.4 * 1.0, 1e-5);
     std::vector<float> live = {0.5f, 0.0f};
-    lipsync::blendHeardJaw(poses, 1.0, live, true);
+    lipsync::blendHeardJaw(poses, 1.0, live, lipsync::HeardSpeech::aligned);
     EXPECT_NEAR(live[0], 0.7f, 1e-6f);
 }
 
@@ -76,6 +76,27 @@ TEST(HeardJaw, AClosureTheSchedulePlacesStaysClosed) {
     auto t = track({{0.0f, 1.0f}});
     lipsync::blendHeardJaw(poses, heardThroughout(0.9f, 30), t);
     EXPECT_FLOAT_EQ(t.frame(0)[0], 0.0f);
+}
+
+TEST(HeardJaw, FromAudioAloneAClosureTheEarHearsOpenIsDoubtedButNotAlignedOrLive) {
+    const auto poses = lipsync::PoseSet::load(
+        poseFile("[[pose]]\nname = \"jaw\"\nheard_jaw = 0.8\nheard_jaw_aligned = 0.4\n"
+                 "heard_jaw_closed_by = \"pbm\"\nheard_jaw_doubts_closure = [0.3, 0.4]\n"
+                 "[[pose]]\nname = \"pbm\"\n"));
+    const auto blended = [&](float heard, bool aligned) {
+        auto t = track({{0.0f, 1.0f}});  // the schedule closes the lips
+        auto levels = heardThroughout(heard, 30);
+        levels.aligned = aligned;
+        lipsync::blendHeardJaw(poses, levels, t);
+        return t.frame(0)[0];
+    };
+    EXPECT_FLOAT_EQ(blended(0.2f, false), 0.0f);                 // heard nearly closed: held
+    EXPECT_NEAR(blended(0.35f, false), 0.8 * 0.35 * 0.5, 1e-5);  // half doubted
+    EXPECT_NEAR(blended(0.9f, false), 0.8 * 0.9, 1e-5);          // heard open: the ear decides
+    EXPECT_FLOAT_EQ(blended(0.9f, true), 0.0f);                  // aligned: the closure is known
+    std::vector<float> live = {0.0f, 1.0f};
+    lipsync::blendHeardJaw(poses, 0.9, live);  // live: no dips to close the jaw instead
+    EXPECT_FLOAT_EQ(live[0], 0.0f);
 }
 
 TEST(HeardJaw, NothingChangesWithoutAHeardJaw) {
@@ -101,9 +122,12 @@ TEST(HeardJaw, OneFrameOfALiveStreamBlendsAsTheOfflineTrackDoes) {
 }
 
 TEST(HeardJaw, APoseSetRejectsABadShareOrAnUnknownClosingPose) {
-    for (const std::string body : {"[[pose]]\nname = \"jaw\"\nheard_jaw = 1.5\n",
-                                   "[[pose]]\nname = \"jaw\"\nheard_jaw_aligned = -0.1\n",
-                                   "[[pose]]\nname = \"jaw\"\nheard_jaw_closed_by = \"lips\"\n"}) {
+    for (const std::string body :
+         {"[[pose]]\nname = \"jaw\"\nheard_jaw = 1.5\n",
+          "[[pose]]\nname = \"jaw\"\nheard_jaw_aligned = -0.1\n",
+          "[[pose]]\nname = \"jaw\"\nheard_jaw_closed_by = \"lips\"\n",
+          "[[pose]]\nname = \"jaw\"\nheard_jaw_doubts_closure = [0.4, 0.3]\n",
+          "[[pose]]\nname = \"jaw\"\nheard_jaw_doubts_closure = [0.3]\n"}) {
         const auto file = poseFile(body);
         try {
             lipsync::PoseSet::load(file);

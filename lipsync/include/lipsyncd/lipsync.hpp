@@ -46,6 +46,11 @@ struct Pose {
     // A pose (the lips' closure) whose weight w holds the heard jaw back to (1 − w) of its share:
     // a closure the schedule places stays closed. Empty: none.
     std::string heardJawClosedBy;
+    // Offline, on speech analysed from audio alone, that closure is doubted where the heard jaw
+    // is open: it holds the heard jaw back fully below closureHeldBelow, not at all above
+    // closureDoubtedAbove, and in between in proportion. Above 1 both: never doubted.
+    double closureHeldBelow = 2;
+    double closureDoubtedAbove = 2;
     // Offline, on speech analysed from audio alone: a clear dip (the weight rising by dipRise
     // on both sides) is lowered by dipDepth at its lowest point (deepenDips). 0: none.
     double dipDepth = 0;
@@ -281,10 +286,15 @@ void deepenDips(const PoseSet& poses, PoseTrack& track, const DipConfig& config 
 inline constexpr double kHeardJawSmoothingSeconds = 0.04;
 void blendHeardJaw(const PoseSet& poses, const LevelTrack& levels, PoseTrack& track,
                    double smoothingSeconds = kHeardJawSmoothingSeconds);
+// What the heard jaw is blended into: speech analysed offline from audio alone (the
+// schedule's closures doubted where the heard jaw is open, as the dips of deepenDips close the
+// jaw instead), speech aligned on its words (heard_jaw_aligned), or a live stream (heard_jaw,
+// every closure the schedule places kept: it has no dips to close the jaw).
+enum class HeardSpeech { analysed, aligned, live };
 // One frame of weights (poses in pose-set order) and the jaw heard around its time: what the
 // offline blend does per frame, for a live stream (the service's live mode).
 void blendHeardJaw(const PoseSet& poses, double heard, std::span<float> weights,
-                   bool aligned = false);
+                   HeardSpeech speech = HeardSpeech::live);
 
 // Streaming: L is a decaying peak of the levels seen so far; frames are shaped as they leave.
 class LoudnessShaper {
