@@ -15,6 +15,9 @@
 //   RuntimeSpec      the runtime as a user names it (pose set, curves or character, phoneme
 //                    set, kind, steps); `lipsync`'s options and lipsyncd's [mouth] fill it.
 //   Runtime          a RuntimeSpec loaded once: the one place both build the runtime from.
+//                    Where the audio is known it also blends in the heard jaw (blendHeardJaw),
+//                    shapes by loudness (shapeByLoudness) and, from the audio alone, deepens
+//                    the jaw's dips between syllables (deepenDips).
 #pragma once
 
 #include <cstddef>
@@ -54,7 +57,7 @@ struct Pose {
     // Offline, on speech analysed from audio alone: a clear dip (the weight rising by dipRise
     // on both sides) is lowered by dipDepth at its lowest point (deepenDips). 0: none.
     double dipDepth = 0;
-    double dipRise = 0.15;
+    double dipRise = 0.05;
 };
 
 // The mouth rests when speech stops: from the start of a silence at least `minPause` long (and
