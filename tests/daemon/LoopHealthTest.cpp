@@ -51,8 +51,14 @@ TEST(LoopHealth, ADaemonHeldBackSaysSoInStatusAndTheLog) {
     d.start();
     Client c(d.socket());
     ASSERT_TRUE(c.connected());
-    const auto before = c.request({{"cmd", "status"}})["loop"];
-    EXPECT_GT(before["ticks"].get<int>(), 0) << before;
+    // The socket answers as soon as the daemon listens; its loop may not have ticked yet on a
+    // busy machine: wait (up to 5 s) until it has.
+    auto before = c.request({{"cmd", "status"}})["loop"];
+    for (int i = 0; i < 500 && before["ticks"].get<int>() == 0; ++i) {
+        std::this_thread::sleep_for(10ms);
+        before = c.request({{"cmd", "status"}})["loop"];
+    }
+    ASSERT_GT(before["ticks"].get<int>(), 0) << before;
     ::kill(d.pid, SIGSTOP);
     std::this_thread::sleep_for(250ms);
     ::kill(d.pid, SIGCONT);
