@@ -4,13 +4,12 @@
 // rest; `lipsync devices` lists buses, ports and chips.
 #include <fcntl.h>
 #include <gtest/gtest.h>
-#include <poll.h>
-#include <stdlib.h>
 
 #include <algorithm>
 #include <fstream>
 #include <lipsyncd/core.hpp>
 
+#include "../support/PseudoTerminal.hpp"
 #include "RunLipsync.hpp"
 
 namespace lipsyncd::test {
@@ -37,11 +36,8 @@ TEST(ServoBoardsCli, CheckPrintsTheLinkageTableAndRefusesAnUnreachableOne) {
 }
 
 TEST(ServoBoardsCli, DriveSendsMaestroTargetsToAPseudoTerminalEndingAtRest) {
-    const int master = posix_openpt(O_RDWR | O_NOCTTY);
-    ASSERT_GE(master, 0);
-    ASSERT_EQ(grantpt(master), 0);
-    ASSERT_EQ(unlockpt(master), 0);
-    const std::string port = ptsname(master);
+    Pty pty;
+    const std::string port = pty.slave();
     const int keep = ::open(port.c_str(), O_RDWR | O_NOCTTY);  // the pty outlives the run
     const auto dir = scratchDir("drive_maestro");
     auto text = slurp(findDataFile("puppets/maestro-jaw.toml"));
@@ -56,17 +52,8 @@ TEST(ServoBoardsCli, DriveSendsMaestroTargetsToAPseudoTerminalEndingAtRest) {
     const auto r = runLipsync({"drive", "--weights", (dir / "w.csv").string(), "--puppet",
                                (dir / "maestro.toml").string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    // A pty hands the bytes over in chunks, some after the writer has exited: read until
-    // nothing more arrives for half a second, not once (a single read lost the rest in CI).
-    std::vector<unsigned char> bytes;
-    for (pollfd p{master, POLLIN, 0}; ::poll(&p, 1, 500) > 0;) {
-        unsigned char chunk[4096];
-        const ssize_t got = ::read(master, chunk, sizeof chunk);
-        if (got <= 0) break;
-        bytes.insert(bytes.end(), chunk, chunk + got);
-    }
+    const auto bytes = pty.drain(500);  // until quiet: some bytes arrive after lipsync has exited
     ::close(keep);
-    ::close(master);
     ASSERT_GT(bytes.size(), 8u);
     ASSERT_EQ(bytes.size() % 4, 0u);  // compact protocol: 4 bytes a command, nothing else
     EXPECT_EQ(bytes[0], 0x87);        // speed limit first, then acceleration

@@ -3,55 +3,18 @@
 // the pulse limits that follow the jaw, rest last; the port closing and coming back (a USB
 // cable pulled and plugged in again, /dev/serial/by-id pointing at the new tty); a port that
 // is not a tty, one that is not there, one the user may not open.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <poll.h>
 #include <stdlib.h>
 
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
+#include "../support/PseudoTerminal.hpp"
 #include "OutputTestSupport.hpp"
 
 namespace lipsyncd::test {
 namespace {
-
-class Pty {
-  public:
-    Pty() {
-        master_ = posix_openpt(O_RDWR | O_NOCTTY);
-        EXPECT_GE(master_, 0);
-        EXPECT_EQ(grantpt(master_), 0);
-        EXPECT_EQ(unlockpt(master_), 0);
-        slave_ = ptsname(master_);
-        fcntl(master_, F_SETFL, O_NONBLOCK);
-    }
-    ~Pty() { close(); }
-    Pty(const Pty&) = delete;
-    Pty& operator=(const Pty&) = delete;
-    const std::string& slave() const { return slave_; }
-    void close() {
-        if (master_ >= 0) ::close(master_);
-        master_ = -1;
-    }
-    // What has arrived so far; with quietMs, also what arrives until the line has been quiet
-    // that long (a pty passes bytes on asynchronously, some after the write has returned).
-    std::vector<std::uint8_t> drain(int quietMs = 0) {
-        std::vector<std::uint8_t> out;
-        std::uint8_t buf[4096];
-        for (pollfd p{master_, POLLIN, 0}; ::poll(&p, 1, quietMs) > 0;) {
-            const ssize_t n = ::read(master_, buf, sizeof buf);
-            if (n <= 0) break;
-            out.insert(out.end(), buf, buf + n);
-        }
-        return out;
-    }
-
-  private:
-    int master_ = -1;
-    std::string slave_;
-};
 
 struct MaestroCommand {
     int device;  // -1: compact protocol
