@@ -191,7 +191,7 @@ TEST(Jaw, TheFadeBeforeAPauseDoesNotShutTheMouthButQuietSpeechStillNarrowsIt) {
     EXPECT_NEAR(heldShort, plainShort, 1e-4);
 }
 
-// A jaw track of the shipped poses, 100 frames a second, the jaw following `jaw(t)` and every
+// A jaw track of the shipped poses, 100 frames a second, the jaw at frame f `jaw(f)` and every
 // other pose at 0.3.
 template <class Jaw>
 PoseTrack jawTrack(std::size_t frames, Jaw jaw) {
