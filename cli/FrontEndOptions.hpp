@@ -48,6 +48,10 @@ struct FrontEndOptions {
                         "Shortest consonant segment, seconds", 0.0, 0.5);
         addNumberOption(cmd, "--min-silence", segmenter.minSilenceSeconds,
                         "Shortest silence, seconds", 0.0, 0.5);
+        addNumberOption(cmd, "--stop-closure", segmenter.stopClosureSeconds,
+                        "A silence shorter than this, seconds, between two speech segments is "
+                        "a stop's closure and takes the stop's class (0: off)",
+                        0.0, 0.5);
         addNumberOption(
             cmd, "--silence-below-peak", classifier.silenceBelowPeakDb,
             "Frames this many dB below the recent speech peak are silence, whatever the noise "

@@ -10,6 +10,13 @@ namespace lipsyncd::dsp {
 
 Segmenter::Segmenter(const PhonemeSet& set, double hopSeconds, const SegmenterConfig& config)
     : set_(&set), hop_(hopSeconds), config_(config) {
+    if (config_.stopClosureSeconds > 0) {
+        const auto closure = set.find(config_.closureClass);
+        if (!closure)
+            throw InputError("segmenter: the stop closure class '" + config_.closureClass +
+                             "' is not in the phoneme set");
+        closure_ = static_cast<int>(*closure);
+    }
     pending_.reserve(16);
     out_.reserve(16);
 }
@@ -26,11 +33,16 @@ double Segmenter::delaySeconds() const {
            hop_;
 }
 
-void Segmenter::emit(const Run& run) {
+void Segmenter::emit(const Run& run, bool followed) {
     PhonemeSegment seg;
     seg.start = std::max(run.start, emittedUntil_);
     seg.end = run.end;
     seg.phoneme = (*set_)[static_cast<std::size_t>(run.phoneme)].name;
+    const bool silence = run.phoneme == static_cast<int>(set_->silence());
+    if (silence && closure_ >= 0 && followed && lastWasSpeech_ &&
+        run.end - seg.start < config_.stopClosureSeconds - 1e-9)
+        seg.phoneme = (*set_)[static_cast<std::size_t>(closure_)].name;
+    lastWasSpeech_ = !silence;
     seg.confidence = run.frames > 0 ? run.confidenceSum / run.frames : 0.0f;
     if (seg.end > seg.start) out_.push_back(std::move(seg));
     emittedUntil_ = run.end;
@@ -66,9 +78,12 @@ void Segmenter::settle(bool final) {
     if (final && !pending_.empty()) absorbIfFlicker(pending_.size() - 1);
     std::size_t emitted = 0;
     while (pending_.size() - emitted >= 2 && !tooShort(pending_[emitted + 1]))
-        emit(pending_[emitted++]);
+        emit(pending_[emitted++], true);
     if (final)
-        while (emitted < pending_.size()) emit(pending_[emitted++]);
+        while (emitted < pending_.size()) {
+            emit(pending_[emitted], emitted + 1 < pending_.size());
+            ++emitted;
+        }
     pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(emitted));
 }
 

@@ -82,6 +82,40 @@ TEST(Segmenter, EmitsEachSegmentWithinItsReportedDelay) {
     EXPECT_LE(worst, seg.delaySeconds() + 1e-9);
 }
 
+TEST(Segmenter, AShortSilenceInsideSpeechIsAStopClosureNotAPause) {
+    // 60 ms of silence between two vowels is the closure of a stop (the t of "atta"): the
+    // mouth holds a consonant there. 200 ms is a pause, and silence before the first sound
+    // or after the last stays silence however short.
+    const auto closure = segment(concat({repeat("sil", 5), repeat("aa", 10), repeat("sil", 6),
+                                         repeat("aa", 10), repeat("sil", 5)}));
+    ASSERT_EQ(closure.size(), 5u);
+    EXPECT_EQ(closure[0].phoneme, "sil");
+    EXPECT_EQ(closure[2].phoneme, "d");
+    EXPECT_NEAR(closure[2].end - closure[2].start, 0.06, 1e-9);
+    EXPECT_EQ(closure[4].phoneme, "sil");
+
+    const auto pause = segment(concat({repeat("aa", 10), repeat("sil", 20), repeat("aa", 10)}));
+    ASSERT_EQ(pause.size(), 3u);
+    EXPECT_EQ(pause[1].phoneme, "sil");
+
+    dsp::SegmenterConfig off;
+    off.stopClosureSeconds = 0;
+    EXPECT_EQ(
+        segment(concat({repeat("aa", 10), repeat("sil", 6), repeat("aa", 10)}), off)[1].phoneme,
+        "sil");
+}
+
+TEST(Segmenter, AStopClosureClassTheSetLacksIsRefusedByName) {
+    dsp::SegmenterConfig c;
+    c.closureClass = "tt";
+    try {
+        dsp::Segmenter seg(PhonemeSet::common(), 0.01, c);
+        FAIL() << "accepted a closure class the set lacks";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("'tt'"), std::string::npos) << e.what();
+    }
+}
+
 TEST(TemplateSet, MalformedFilesNameTheField) {
     const auto dir = std::filesystem::temp_directory_path();
     auto errorOf = [&](const std::string& text) {
