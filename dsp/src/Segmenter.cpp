@@ -2,7 +2,9 @@
 // flicker and merge into the run before them (hysteresis in time; notes/dsp.md: a 120 ms hold
 // made viseme changes "markedly more natural"; phonemes need less). A run is final once the
 // run after it has reached its own minimum length: nothing later can then move the boundary
-// between them, so the delay is bounded by the longest minimum plus one hop.
+// between them, so the delay is bounded by the longest minimum plus one hop. A silence is final
+// only once it has ended, so its length is known when it is emitted: a short one inside speech
+// is a stop's closure, not a pause (SegmenterConfig::stopClosureSeconds), at no extra delay.
 #include <algorithm>
 #include <lipsyncd/dsp.hpp>
 

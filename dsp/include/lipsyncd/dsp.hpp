@@ -461,7 +461,7 @@ struct SegmenterConfig {
     // phonetic labels and espeak-ng's own timings count it (0: every silence stays one).
     // Tune voices, audio only (visual groups summed over six; score as in
     // docs/measurements.md): off 283.4 (685.0), 0.06 / 0.08 / 0.1 / 0.12 / 0.15 / 0.2 s
-    // 288.0 / 289.8 / 290.9 / 291.2 / 291.3 / 290.9, jaw r unchanged. From 0.1 s on, the
+    // 288.0 / 289.6 / 290.9 / 291.2 / 291.3 / 290.9, jaw r unchanged. From 0.1 s on, the
     // espeak-ng dev voices lose points (their pauses between words are that short): 0.08.
     double stopClosureSeconds = 0.08;
     std::string closureClass = "d";  // t d n: the commonest stop
