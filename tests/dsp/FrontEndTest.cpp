@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -197,6 +198,43 @@ TEST(FrontEnd, SegmentsCloseWithinTheReportedLatency) {
     EXPECT_GT(segments, 5);
     EXPECT_LE(worstLag, analyzer.latencySeconds() + 0.011);
     EXPECT_LT(analyzer.latencySeconds(), 0.2);
+}
+
+namespace {
+// A vowel of espeak-ng's cut by `gapSeconds` of digital silence, as a stop's closure cuts one;
+// returns the class the front end gives the middle of the gap.
+std::string classInAGapOf(double gapSeconds, dsp::FrontEndConfig config = {}) {
+    const auto speech = test::speak(test::espeak(), "father", "en-us");
+    const auto vowel = std::find_if(speech.labels.begin(), speech.labels.end(),
+                                    [](const PhonemeSegment& s) { return s.phoneme == "aa"; });
+    EXPECT_NE(vowel, speech.labels.end());
+    const double cut = 0.5 * (vowel->start + vowel->end);
+    const auto at = static_cast<std::ptrdiff_t>(cut * speech.rate);
+    std::vector<float> samples(speech.samples.begin(), speech.samples.begin() + at);
+    samples.resize(samples.size() + static_cast<std::size_t>(gapSeconds * speech.rate), 0.0f);
+    samples.insert(samples.end(), speech.samples.begin() + at, speech.samples.end());
+
+    dsp::StreamingAnalyzer analyzer(templates(), PhonemeSet::common(), speech.rate, config);
+    PhonemeSchedule schedule;
+    analyzer.onSegment([&](const PhonemeSegment& s) { schedule.push_back(s); });
+    analyzer.push(samples);
+    analyzer.finish();
+    const double middle = cut + gapSeconds / 2;
+    for (const auto& s : schedule)
+        if (s.start <= middle && middle < s.end) return s.phoneme;
+    return "";
+}
+}  // namespace
+
+TEST(FrontEnd, AShortSilenceInsideAWordIsAStopsClosureAndALongOneAPause) {
+    // 90 ms cut into a vowel, of which the front end hears 60 ms as silence (its window reaches
+    // into the gap), is what the closure of a t or k sounds like: the mouth holds a consonant.
+    // 300 ms is a pause, and the mouth may rest.
+    EXPECT_EQ(classInAGapOf(0.09), "d");
+    EXPECT_EQ(classInAGapOf(0.3), "sil");
+    dsp::FrontEndConfig off;
+    off.segmenter.stopClosureSeconds = 0;
+    EXPECT_EQ(classInAGapOf(0.09, off), "sil");
 }
 
 TEST(FrontEnd, BadFilesGetClearErrors) {
