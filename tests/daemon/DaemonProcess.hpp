@@ -170,14 +170,24 @@ struct DaemonProcess {
     }
 };
 
-inline void waitUntilIdle(Client& c, std::chrono::seconds timeout = 20s) {
+// The daemon's status once `ready` holds for it, asked every 50 ms for up to `timeout`; else
+// the last status it gave (the caller asserts on it): on a busy machine the daemon may not
+// yet be where a test needs it.
+template <class Ready>
+json statusWhen(Client& c, Ready ready, std::chrono::milliseconds timeout) {
     const auto end = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < end) {
-        const auto s = c.request({{"cmd", "status"}});
-        if (s["playing"].is_null() && s["queue"].empty()) return;
+    auto s = c.request({{"cmd", "status"}});
+    while (!ready(s) && std::chrono::steady_clock::now() < end) {
         std::this_thread::sleep_for(50ms);
+        s = c.request({{"cmd", "status"}});
     }
-    FAIL() << "still playing after " << timeout.count() << " s";
+    return s;
+}
+
+inline void waitUntilIdle(Client& c, std::chrono::seconds timeout = 20s) {
+    const auto idle = [](const json& s) { return s["playing"].is_null() && s["queue"].empty(); };
+    if (!idle(statusWhen(c, idle, timeout)))
+        FAIL() << "still playing after " << timeout.count() << " s";
 }
 
 }  // namespace lipsyncd::test

@@ -53,11 +53,8 @@ TEST(LoopHealth, ADaemonHeldBackSaysSoInStatusAndTheLog) {
     ASSERT_TRUE(c.connected());
     // The socket answers as soon as the daemon listens; its loop may not have ticked yet on a
     // busy machine: wait (up to 5 s) until it has.
-    auto before = c.request({{"cmd", "status"}})["loop"];
-    for (int i = 0; i < 500 && before["ticks"].get<int>() == 0; ++i) {
-        std::this_thread::sleep_for(10ms);
-        before = c.request({{"cmd", "status"}})["loop"];
-    }
+    const auto ticked = [](const json& s) { return s["loop"]["ticks"].get<int>() > 0; };
+    const auto before = statusWhen(c, ticked, 5s)["loop"];
     ASSERT_GT(before["ticks"].get<int>(), 0) << before;
     ::kill(d.pid, SIGSTOP);
     std::this_thread::sleep_for(250ms);
