@@ -39,11 +39,10 @@ void Segmenter::emit(const Run& run, bool followed) {
     PhonemeSegment seg;
     seg.start = std::max(run.start, emittedUntil_);
     seg.end = run.end;
-    seg.phoneme = (*set_)[static_cast<std::size_t>(run.phoneme)].name;
     const bool silence = run.phoneme == static_cast<int>(set_->silence());
-    if (silence && closure_ >= 0 && followed && lastWasSpeech_ &&
-        run.end - seg.start < config_.stopClosureSeconds - 1e-9)
-        seg.phoneme = (*set_)[static_cast<std::size_t>(closure_)].name;
+    const bool stopClosure = silence && closure_ >= 0 && followed && lastWasSpeech_ &&
+                             run.end - seg.start < config_.stopClosureSeconds - 1e-9;
+    seg.phoneme = (*set_)[static_cast<std::size_t>(stopClosure ? closure_ : run.phoneme)].name;
     lastWasSpeech_ = !silence;
     seg.confidence = run.frames > 0 ? run.confidenceSum / run.frames : 0.0f;
     if (seg.end > seg.start) out_.push_back(std::move(seg));

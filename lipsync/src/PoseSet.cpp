@@ -107,7 +107,8 @@ PoseSet PoseSet::load(const std::filesystem::path& file) {
             const auto& d = *doubt;
             if (d.size() != 2 || !(d[0] >= 0 && d[0] < d[1] && d[1] <= 1))
                 t.fail("heard_jaw_doubts_closure", "must be [from, to] with 0 <= from < to <= 1");
-            p.closureHeldBelow = d[0], p.closureDoubtedAbove = d[1];
+            p.closureHeldBelow = d[0];
+            p.closureDoubtedAbove = d[1];
         }
         p.dipDepth = t.optNumber("dip_depth").value_or(0);
         if (!(p.dipDepth >= 0 && p.dipDepth <= 1)) t.fail("dip_depth", "must be in [0, 1]");
