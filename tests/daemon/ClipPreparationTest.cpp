@@ -191,8 +191,8 @@ json speakerOf(Client& c) {
 // learnt when it is made, before it is heard.
 void prepare(Client& c, const json& request) {
     ASSERT_TRUE(c.request(request)["ok"]);
-    for (int i = 0; i < 400 && c.request({{"cmd", "status"}})["playing"].is_null(); ++i)
-        std::this_thread::sleep_for(50ms);
+    const auto playing = [](const json& s) { return !s["playing"].is_null(); };
+    ASSERT_TRUE(playing(statusWhen(c, playing, 20s))) << "the request never played";
     ASSERT_TRUE(c.request({{"cmd", "stop"}})["ok"]);
 }
 

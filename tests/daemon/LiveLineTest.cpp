@@ -232,12 +232,12 @@ TEST(LiveLine, WithoutAdaptSpeakerALineIsFollowedOnlyAndWithoutEitherRefused) {
     }
     EXPECT_EQ(event.value("words", 0), 17) << event.dump();
     EXPECT_EQ(event.value("text", ""), kHelloWords) << event.dump();
-    json line = json::object();
-    for (int i = 0; i < 100 && !line.value("following", false); ++i) {
-        std::this_thread::sleep_for(50ms);
-        line = cf.request({{"cmd", "status"}})["live_line"];
-        ASSERT_TRUE(line.is_object()) << line.dump();
-    }
+    const auto following = [](const json& s) {
+        const auto line = s.value("live_line", json::object());
+        return line.is_object() && line.value("following", false);
+    };
+    const auto line = statusWhen(cf, following, 5s)["live_line"];
+    ASSERT_TRUE(line.is_object()) << line.dump();
     EXPECT_TRUE(line.value("following", false)) << line.dump();
     // Nothing is kept to learn from.
     EXPECT_EQ(cf.request({{"cmd", "status"}})["memory"]["live_line_bytes"], 0);
