@@ -14,9 +14,8 @@
 #   scripts/train-templates.sh --networks-only  # keep the shipped templates, retrain the networks
 #   scripts/train-templates.sh --channel-normalised  # the opt-in channel-normalised set instead:
 #                                               # config/templates/channel-normalised.json
-#                                               # (shipped with networks from before the
-#                                               # `networks` speakers and 64 units; this retrains
-#                                               # them the way below)
+#   scripts/train-templates.sh --channel-normalised --networks-only  # its networks alone (the
+#                                               # shipped one's: its templates kept)
 # and, to judge a change before it is shipped (scripts/held-out-check.sh does this):
 #   --leave-out SPEAKER   train without this real training speaker (repeatable), so that it can
 #                         be scored as a voice the set has never heard
@@ -33,14 +32,15 @@
 #       --corpus build/real-speech/tune --write
 set -euo pipefail
 usage() {
-  echo "usage: scripts/train-templates.sh [--networks-only | --channel-normalised]" \
+  echo "usage: scripts/train-templates.sh [--networks-only] [--channel-normalised]" \
     "[--leave-out SPEAKER]... [-o OUT.json] [--no-fetch]" >&2
   exit 2
 }
-mode="" out="" fetch=1 leave_out=()
+networks_only=0 normalised=0 out="" fetch=1 leave_out=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --networks-only|--channel-normalised) [ -z "$mode" ] || usage; mode="$1" ;;
+    --networks-only) networks_only=1 ;;
+    --channel-normalised) normalised=1 ;;
     --leave-out) [ $# -ge 2 ] || usage; leave_out+=("$2"); shift ;;
     -o) [ $# -ge 2 ] || usage; out="$2"; shift ;;
     --no-fetch) fetch=0 ;;
@@ -130,7 +130,7 @@ shipped="$here/config/templates/default.json"
 about="espeak-ng $(espeak-ng --version | awk '{print $4}') speech (12 voices and variants, 40 sentences, counted twice) and real speakers ${speakers[*]}"
 [ ${#left[@]} -eq 0 ] || about="$about (left out: ${left[*]})"
 kind="Default templates" detail="24 clusters a class" channel=()
-if [ "$mode" = --channel-normalised ]; then
+if [ "$normalised" = 1 ]; then
   # A running mean spectrum subtracted from every frame (Atal 1974), the training mean worth 2 s
   # of speech. Chosen on the real training speakers each left out of their own set (klettres-en-gb
   # / asterisk-en-allison visual groups, audio only and aligned on the words: 76.3 / 45.0 and
@@ -143,8 +143,8 @@ if [ "$mode" = --channel-normalised ]; then
 fi
 out="${out:-$shipped}"
 # --networks-only keeps the shipped set's templates: a new -o file starts as a copy of it.
-[ "$mode" != --networks-only ] || [ -e "$out" ] || cp "$shipped" "$out"
-if [ "$mode" != --networks-only ]; then
+[ "$networks_only" = 0 ] || [ -e "$out" ] || cp "$shipped" "$out"
+if [ "$networks_only" = 0 ]; then
   "$lipsync" train "${folders[@]}" "${template_folders[@]+"${template_folders[@]}"}" --clusters 24 "${channel[@]}" --jaw-hidden 0 --class-hidden 0 \
     -o "$out" --description "$kind: trained by scripts/train-templates.sh on $about ($detail)"
 fi

@@ -111,7 +111,10 @@ ReferenceFrame referenceAnalysis(std::span<const float> x, const dsp::AnalysisCo
 }  // namespace
 
 TEST(FrontEndKernels, FrameFeaturesMatchAPlainDoublePrecisionAnalysis) {
-    const auto& c = templates().analysis;
+    // The LPC analysis alone: a set's running mean spectrum (channel normalisation) is
+    // SpectrumNormaliser's, tested on its own.
+    auto c = templates().analysis;
+    c.spectrumMean.clear();
     std::size_t compared = 0;
     double worst = 0;
     for (const auto& audio : speechAtAnalysisRate()) {
