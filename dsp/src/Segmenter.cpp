@@ -80,11 +80,8 @@ void Segmenter::settle(bool final) {
     std::size_t emitted = 0;
     while (pending_.size() - emitted >= 2 && !tooShort(pending_[emitted + 1]))
         emit(pending_[emitted++], true);
-    if (final)
-        while (emitted < pending_.size()) {
-            emit(pending_[emitted], emitted + 1 < pending_.size());
-            ++emitted;
-        }
+    for (; final && emitted < pending_.size(); ++emitted)
+        emit(pending_[emitted], emitted + 1 < pending_.size());
     pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(emitted));
 }
 
