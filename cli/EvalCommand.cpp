@@ -13,6 +13,7 @@
 #include "Commands.hpp"
 #include "Corpus.hpp"
 #include "FrontEndOptions.hpp"
+#include "GroupConfusion.hpp"
 #include "Output.hpp"
 #include "PuppetJaw.hpp"
 #include "RuntimeOptions.hpp"
@@ -417,6 +418,15 @@ nlohmann::json jawByClass(const JawScores& jaw, const PhonemeSet& set) {
     return j;
 }
 
+// {labelled class: {heard class: frames}}.
+nlohmann::json confusionJson(const dsp::ScheduleScore& score, const PhonemeSet& set) {
+    auto j = nlohmann::json::object();
+    for (std::size_t r = 0; r < set.size() && r < score.confusion.size(); ++r)
+        for (std::size_t h = 0; h < set.size() && h < score.confusion[r].size(); ++h)
+            if (score.confusion[r][h] > 0) j[set[r].name][set[h].name] = score.confusion[r][h];
+    return j;
+}
+
 struct Report {
     std::vector<Row> files;
     std::map<std::string, Score> speakers;
@@ -433,14 +443,14 @@ nlohmann::json toJson(const Report& report, const PhonemeSet& set, const EvalOpt
         j["files"].push_back(row);
     }
     for (const auto& [name, s] : report.speakers) {
-        j["speakers"][name] = scoreJson(s, o);
-        if (o.jaw) j["speakers"][name]["jaw_by_class"] = jawByClass(s.jaw, set);
+        auto& speaker = j["speakers"][name];
+        speaker = scoreJson(s, o);
+        if (o.jaw) speaker["jaw_by_class"] = jawByClass(s.jaw, set);
+        speaker["confusion"] = confusionJson(s.schedule, set);
+        speaker["group_confusion"] = groupConfusionJson(GroupConfusion::of(s.schedule, set));
     }
     if (o.jaw) j["jaw_by_class"] = jawByClass(report.total.jaw, set);
-    for (std::size_t r = 0; r < set.size(); ++r)
-        for (std::size_t h = 0; h < set.size(); ++h)
-            if (report.total.schedule.confusion[r][h] > 0)
-                j["confusion"][set[r].name][set[h].name] = report.total.schedule.confusion[r][h];
+    j["confusion"] = confusionJson(report.total.schedule, set);
     return j;
 }
 
@@ -496,6 +506,14 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
     printRow(out, "all", report.total, o.jaw);
     if (o.align) printBoundaries(out, report);
     const auto group = worst(report, [](const Score& s) { return s.schedule.groupAccuracy(); });
+    if (const auto w = report.speakers.find(group.first); w != report.speakers.end()) {
+        out << '\n';
+        printGroupConfusion(out,
+                            (report.speakers.size() > 1 ? "visual groups of the worst speaker, "
+                                                        : "visual groups of ") +
+                                group.first,
+                            GroupConfusion::of(w->second.schedule, set));
+    }
     out << "\nfiles " << report.files.size() << ", speakers " << report.speakers.size()
         << ", frames " << report.total.schedule.frames << ": accuracy "
         << pct(report.total.schedule.accuracy()) << " (common set), "

@@ -334,6 +334,42 @@ TEST(LipsyncCli, EvalScoresThePuppetsJawPerSpeaker) {
     EXPECT_NE(bad.err.find("no actuator named 'tail'"), std::string::npos) << bad.err;
 }
 
+// The worst speaker's frames between the visual groups: the table names that speaker, and the
+// JSON holds every speaker's, summing to its frames with its group accuracy on the diagonal.
+TEST(LipsyncCli, EvalShowsWhereTheWorstSpeakersGroupsGo) {
+    const auto dir = scratchDir("cli_eval_groups");
+    for (const auto* speaker : {"alice", "bob"}) {
+        fs::create_directories(dir / speaker);
+        fs::copy_file(exampleWav(), dir / speaker / "hello.wav",
+                      fs::copy_options::overwrite_existing);
+    }
+    auto lab = exampleWav();
+    fs::copy_file(lab.replace_extension(".lab"), dir / "alice" / "hello.lab",
+                  fs::copy_options::overwrite_existing);
+    // bob's labels say the whole line is one open vowel: most of his frames are heard elsewhere.
+    std::ofstream(dir / "bob" / "hello.lab") << "0.000\t5.216\tah\n";
+    const auto r =
+        runLipsync({"eval", "--corpus", dir.string(), "--json", "-", "--no-per-file", "--no-jaw"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("visual groups of the worst speaker, bob"), std::string::npos) << r.out;
+    const auto json = nlohmann::json::parse(r.out.substr(r.out.find("\n{") + 1));
+    for (const auto* name : {"alice", "bob"}) {
+        const auto& speaker = json["speakers"][name];
+        std::size_t frames = 0, same = 0;
+        for (const auto& [labelled, row] : speaker["group_confusion"].items())
+            for (const auto& [heard, n] : row.items()) {
+                frames += n.get<std::size_t>();
+                if (heard == labelled) same += n.get<std::size_t>();
+            }
+        EXPECT_EQ(frames, speaker["frames"].get<std::size_t>()) << name;
+        EXPECT_NEAR(static_cast<double>(same) / frames, speaker["group_accuracy"].get<double>(),
+                    1e-9)
+            << name;
+        EXPECT_TRUE(speaker["confusion"].contains("ah")) << name;
+    }
+    EXPECT_EQ(json["speakers"]["bob"]["group_confusion"].size(), 1u) << "bob's labels: open only";
+}
+
 TEST(LipsyncCli, EvalOnAFolderWithoutLabelsSaysSo) {
     const auto r = runLipsync({"eval", "--corpus", scratchDir("cli_empty").string()});
     EXPECT_EQ(r.exitCode, 1);
