@@ -10,13 +10,13 @@ GroupConfusion GroupConfusion::of(const dsp::ScheduleScore& score, const Phoneme
     GroupConfusion c;
     c.groups = set.groups();
     c.frames.assign(c.groups.size(), std::vector<std::size_t>(c.groups.size(), 0));
-    const auto groupOf = [&](std::size_t cls) {
-        return static_cast<std::size_t>(
-            std::find(c.groups.begin(), c.groups.end(), set[cls].group) - c.groups.begin());
-    };
+    std::vector<std::size_t> groupOf;  // per class of the set: its group's index
+    for (std::size_t cls = 0; cls < set.size(); ++cls)
+        groupOf.push_back(static_cast<std::size_t>(
+            std::find(c.groups.begin(), c.groups.end(), set[cls].group) - c.groups.begin()));
     for (std::size_t r = 0; r < score.confusion.size() && r < set.size(); ++r)
         for (std::size_t h = 0; h < score.confusion[r].size() && h < set.size(); ++h)
-            c.frames[groupOf(r)][groupOf(h)] += score.confusion[r][h];
+            c.frames[groupOf[r]][groupOf[h]] += score.confusion[r][h];
     return c;
 }
 
