@@ -232,6 +232,10 @@ struct Evaluator {
         daemon::DaemonConfig c;
         c.hardware = false;
         c.templates = o.frontEnd.templates;
+        // The front end as the options set it, not the service's defaults: a --class-bias or a
+        // --min-vowel measured live must reach the live path.
+        c.frontEnd = std::make_shared<const dsp::FrontEndConfig>(o.frontEnd.config());
+        c.templateSet = std::make_shared<const dsp::TemplateSet>(templates);
         c.runtime = o.runtime.spec;
         c.voice = voiceFor(speaker);
         c.adaptSpeaker = o.adaptSpeaker;
@@ -576,6 +580,8 @@ void checkFloors(const Report& report, const EvalOptions& o) {
 }
 
 void runEval(const EvalOptions& o) {
+    if (o.live && o.frontEnd.decoder.enabled && o.frontEnd.decoder.lagSeconds < 0)
+        throw InputError("--live with --offline: live input is decoded at a fixed lag (--lag)");
     const Evaluator evaluator(o);
     std::vector<std::string> skipped;
     auto items = listCorpus(o.corpus, &skipped);
@@ -679,8 +685,9 @@ void addEvalCommand(CLI::App& app) {
                   "and loudness as live), the schedule being what the runtime took; with --align "
                   "each file is cued with its words and followed (at --follow-lag, default "
                   "[live] follow_lag), with --adapt-speaker the service's show voice learns "
-                  "each line after it. Takes --templates and the runtime options; the front end "
-                  "runs as lipsyncd runs it");
+                  "each line after it. Takes --templates, the front end's options (--class-bias, "
+                  "--lag, ...) and the runtime options; with none given the front end runs as "
+                  "lipsyncd runs it");
     o->aligner.addTo(*cmd, "With --align");
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "

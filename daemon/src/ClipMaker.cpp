@@ -31,7 +31,7 @@ struct ClipMaker::Impl {
     explicit Impl(const DaemonConfig& c)
         : config(c),
           runtime(c.runtime),
-          templates(dsp::TemplateSet::named(c.templates)),
+          templates(c.templateSet ? *c.templateSet : dsp::TemplateSet::named(c.templates)),
           poseNames(runtime.poses().names()) {}
 };
 
@@ -60,6 +60,11 @@ ShowSpeaker* ClipMaker::speaker() const {
 
 const std::vector<std::string>& ClipMaker::poseNames() const {
     return impl_->poseNames;
+}
+
+const dsp::FrontEndConfig& ClipMaker::frontEnd() const {
+    static const dsp::FrontEndConfig defaults;
+    return impl_->config.frontEnd ? *impl_->config.frontEnd : defaults;
 }
 
 namespace {
@@ -160,8 +165,8 @@ ClipMaker::LineLesson ClipMaker::learnFromLine(
     auto lesson = impl_->speaker->startLesson();
     dsp::AlignFileResult r;
     try {
-        r = alignText(synth, wav.path(), text, impl_->config.voice, impl_->templates, {}, {}, {},
-                      std::nullopt, true, &lesson.voice);
+        r = alignText(synth, wav.path(), text, impl_->config.voice, impl_->templates, frontEnd(),
+                      {}, {}, std::nullopt, true, &lesson.voice);
     } catch (const InputError& e) {
         return {false, wav.named(e.what(), name)};
     }
@@ -184,7 +189,7 @@ std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
     // Live input follows the show's voice as the lines with words before it taught it.
     const auto& templates = impl_->speaker ? impl_->speaker->templates() : impl_->templates;
     return std::make_unique<StreamingLive>(templates, impl_->runtime, rate,
-                                           impl_->config.followLagSeconds);
+                                           impl_->config.followLagSeconds, frontEnd());
 }
 
 std::vector<dsp::ScriptWord> ClipMaker::readLine(const std::string& text,

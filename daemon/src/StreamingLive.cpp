@@ -11,8 +11,8 @@ const std::string& className(int c) {
 }  // namespace
 
 StreamingLive::StreamingLive(const dsp::TemplateSet& templates, const lipsync::Runtime& runtime,
-                             int rate, double followLagSeconds)
-    : analyzer_(templates, PhonemeSet::common(), rate),
+                             int rate, double followLagSeconds, const dsp::FrontEndConfig& frontEnd)
+    : analyzer_(templates, PhonemeSet::common(), rate, frontEnd),
       runtime_(runtime.streaming(0)),
       poses_(&runtime.poses()),
       shaper_(runtime.poses()),

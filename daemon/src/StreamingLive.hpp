@@ -19,7 +19,7 @@ class StreamingLive : public ClipMaker::Live {
   public:
     // `followLagSeconds`: how far behind the newest frame a followed line's frames are decided.
     StreamingLive(const dsp::TemplateSet& templates, const lipsync::Runtime& runtime, int rate,
-                  double followLagSeconds);
+                  double followLagSeconds, const dsp::FrontEndConfig& frontEnd = {});
     void push(std::span<const float> samples, PoseTrack& out) override;
     // Following a line, a frame's phoneme is out `followLag` after the frame is (the decoder's
     // and the segmenter's delays are not on that path); else the front end's bound.

@@ -106,6 +106,29 @@ TEST(AlignCli, EvalLiveScoresTheServicesLivePath) {
     EXPECT_GT(f["jaw"]["audio"]["r"].get<double>(), 0.7);
 }
 
+// The front end's options reach the live path (they were once left at lipsyncd's defaults):
+// a class favoured by 12 dB takes the line's frames live as it does offline. Live input cannot
+// wait for the whole file, so --offline decoding is refused.
+TEST(AlignCli, EvalLiveTakesTheFrontEndsOptions) {
+    const auto dir = scratchDir("cli_eval_live_options");
+    const std::string en = "Seven puppets sang a song about the moon.";
+    speak(dir / "anna", "line", en, "en-us+f3", en);
+    const auto groups = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args{"eval", "--corpus", dir.string(), "--live", "--json", "-"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const auto r = runLipsync(args);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        const auto j = nlohmann::json::parse(r.out.substr(r.out.find("\n{") + 1));
+        return j["speakers"]["anna"]["group_accuracy"].get<double>();
+    };
+    const double asShipped = groups({}), bilabials = groups({"--class-bias", "bmp=-12"});
+    EXPECT_GT(asShipped, 0.6);
+    EXPECT_LT(bilabials, asShipped - 0.2);
+    const auto offline = runLipsync({"eval", "--corpus", dir.string(), "--live", "--offline"});
+    EXPECT_EQ(offline.exitCode, 1);
+    EXPECT_NE(offline.err.find("--live with --offline"), std::string::npos) << offline.err;
+}
+
 TEST(AlignCli, EvalAlignWithoutAnyWordsFileSaysSo) {
     const auto dir = scratchDir("cli_eval_align_none");
     speak(dir, "line", "Open wide.", "en-us", "");

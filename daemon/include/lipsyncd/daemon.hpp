@@ -35,6 +35,8 @@ namespace lipsyncd {
 class EspeakSynthesizer;
 namespace dsp {
 struct ScriptWord;
+struct FrontEndConfig;
+struct TemplateSet;
 }
 }  // namespace lipsyncd
 
@@ -74,6 +76,10 @@ struct DaemonConfig {
     double maxClipSeconds = 30;
     std::size_t maxTextBytes = 600;
     std::size_t maxQueue = 8;
+    // Not in the config file: the front end as `lipsync eval --live` was told to run it (its
+    // settings, and the set its --class-bias changed). Null: the defaults and `templates`.
+    std::shared_ptr<const dsp::FrontEndConfig> frontEnd;
+    std::shared_ptr<const dsp::TemplateSet> templateSet;
 
     static DaemonConfig load(const std::filesystem::path& file);  // InputError with file:line
 };
@@ -202,6 +208,7 @@ class ClipMaker {
     std::unique_ptr<Live> startLive(int rate) const;
 
   private:
+    const dsp::FrontEndConfig& frontEnd() const;
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
