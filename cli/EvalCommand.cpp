@@ -687,7 +687,7 @@ void addEvalCommand(CLI::App& app) {
                   "[live] follow_lag), with --adapt-speaker the service's show voice learns "
                   "each line after it. Takes --templates, the front end's options (--class-bias, "
                   "--lag, ...) and the runtime options; with none given the front end runs as "
-                  "lipsyncd runs it");
+                  "lipsyncd runs it, and the aligner always does");
     o->aligner.addTo(*cmd, "With --align");
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "

@@ -10,7 +10,10 @@ move kept when the score over the voices rises, until no move helps; then the st
 The score is what a puppet shows, summed over the speakers of every corpus (`lipsync eval`,
 audio only, per speaker, in percent): visual groups + 50 × jaw r + 0.5 × (bilabial closures
 caught − false closures). A hundredth of jaw r weighs half a point of visual groups; a closure
-caught and a false closure weigh the same.
+caught and a false closure weigh the same. With --live-too each corpus is also scored through
+the service's live path (`eval --live`) and both scores are added: the live mouth has no dips of
+the jaw to close it and leans on the bilabials heard, so a bias fitted on files alone can cost it
+closures.
 
     scripts/fit-class-bias.py --set config/templates/default.json \\
         --corpus build/real-speech/tune --write
@@ -54,6 +57,8 @@ def parse_args(argv):
                         "groups; smaller moves fit the voices' quirks)")
     p.add_argument("--jobs", type=int, default=2, help="evaluations run at once (default 2)")
     p.add_argument("--start", default="", help="starting bias, CLASS=DB,... (default: none)")
+    p.add_argument("--live-too", action="store_true",
+                   help="also score each corpus through the live path (eval --live) and add it")
     p.add_argument("--write", action="store_true", help="write the bias into --set")
     p.add_argument("eval_options", nargs="*", help="after --: more `lipsync eval` options")
     return p.parse_args(argv)
@@ -62,11 +67,13 @@ def parse_args(argv):
 def evaluate(args, bias):
     """Per speaker over every corpus: (visual groups, jaw r, closures caught, false), percent."""
     rows = []
-    for item in args.corpus:
+    paths = [[], ["--live"]] if args.live_too else [[]]
+    for item, path in ((i, p) for i in args.corpus for p in paths):
         corpus, _, tset = item.partition("=")
         with tempfile.NamedTemporaryFile(suffix=".json") as out:
             cmd = [args.lipsync, "eval", "--corpus", corpus, "--templates", tset or args.set,
-                   "--no-per-file", "--json", out.name, "--no-class-bias", *args.eval_options]
+                   "--no-per-file", "--json", out.name, "--no-class-bias", *path,
+                   *args.eval_options]
             for name, db in sorted(bias.items()):
                 if db:
                     cmd += ["--class-bias", f"{name}={db:g}"]

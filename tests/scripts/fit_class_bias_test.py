@@ -12,8 +12,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 FIT = ROOT / "scripts" / "fit-class-bias.py"
 
-# Visual groups peak at ah −0.6 dB and w +0.3 dB; closures and jaw do not move. Every call must
-# start from no bias (--no-class-bias) and say the biases it tries.
+# Visual groups peak at ah −0.6 dB and w +0.3 dB; closures and jaw do not move, but through the
+# live path (--live) the closures caught peak at bmp −0.3 dB. Every call must start from no bias
+# (--no-class-bias) and say the biases it tries.
 FAKE_LIPSYNC = r"""#!/usr/bin/env python3
 import json, sys
 args = sys.argv[1:]
@@ -24,7 +25,8 @@ for i, a in enumerate(args):
         name, db = args[i + 1].split("=")
         bias[name] = float(db)
 g = 0.5 - 0.3 * (bias.get("ah", 0) + 0.6) ** 2 - 0.3 * (bias.get("w", 0) - 0.3) ** 2
-jaw = {"r": 0.7, "closures": 10, "closures_caught": 0.9, "false_closures": 0.05}
+caught = 0.9 - (0.5 * (bias.get("bmp", 0) + 0.3) ** 2 if "--live" in args else 0)
+jaw = {"r": 0.7, "closures": 10, "closures_caught": caught, "false_closures": 0.05}
 out = args[args.index("--json") + 1]
 json.dump({"speakers": {"voice-a": {"group_accuracy": g, "jaw": {"audio": jaw}}}}, open(out, "w"))
 """
@@ -90,6 +92,14 @@ class FitClassBias(unittest.TestCase):
         r = self.fit("--min-gain", "3", "--steps", "0.3")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertEqual(json.loads(r.stdout.splitlines()[-1]), {"ah": -0.3})
+
+    def test_live_too_fits_the_bias_for_the_live_path_as_well(self):
+        r = self.fit("--steps", "0.3")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(json.loads(r.stdout.splitlines()[-1]), {"ah": -0.6, "w": 0.3})
+        r = self.fit("--steps", "0.3", "--live-too")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(json.loads(r.stdout.splitlines()[-1]), {"ah": -0.6, "bmp": -0.3, "w": 0.3})
 
     def test_a_failing_evaluation_is_reported(self):
         r = subprocess.run([sys.executable, str(FIT), "--set", str(self.set), "--corpus",
