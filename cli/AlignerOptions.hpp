@@ -6,6 +6,7 @@
 #include <cctype>
 #include <lipsyncd/dsp.hpp>
 #include <string>
+#include <vector>
 
 #include "NumberOption.hpp"
 
@@ -14,6 +15,7 @@ namespace lipsyncd::cli {
 struct AlignerOptions {
     dsp::AlignerConfig config;
     bool reductions = true;
+    std::vector<CLI::Option*> added;  // what addTo() added: a command may exclude them together
 
     // `when`: what the options depend on, said before each help text ("With --align"), or empty.
     void addTo(CLI::App& cmd, const std::string& when = "") {
@@ -27,7 +29,7 @@ struct AlignerOptions {
         // A cost, share or floor: a number from 0 to `max`, its default shown.
         const auto number = [&](const std::string& name, float& field, const std::string& text,
                                 double max) {
-            addNumberOption(cmd, name, field, help(text), 0.0, max);
+            added.push_back(addNumberOption(cmd, name, field, help(text), 0.0, max));
         };
         number("--min-word-confidence", config.minWordConfidence,
                "words placed with less confidence get audio-only analysis; in a line whose median "
@@ -46,9 +48,10 @@ struct AlignerOptions {
                "how much of the class network's term (and the class bias) the aligner weighs "
                "beside the templates' distances (0: the templates alone)",
                1.0);
-        cmd.add_flag("!--no-reductions", reductions,
-                     help("follow espeak-ng's reading only, without the common reductions "
-                          "(config/reductions/LANG.toml: weak forms, t/d and schwa deletion)"));
+        added.push_back(cmd.add_flag(
+            "!--no-reductions", reductions,
+            help("follow espeak-ng's reading only, without the common reductions "
+                 "(config/reductions/LANG.toml: weak forms, t/d and schwa deletion)")));
     }
 };
 

@@ -679,15 +679,16 @@ void addEvalCommand(CLI::App& app) {
                     "words), instead of aligning the whole file")
         ->check(CLI::Range(0.0, dsp::AlignerConfig{}.lookaheadSeconds))
         ->needs(align);
-    cmd->add_flag("--live", o->live,
-                  "Score the service's live path instead: each file fed to lipsyncd's live input "
-                  "10 ms at a time (its front end, the runtime in its causal mode, the heard jaw "
-                  "and loudness as live), the schedule being what the runtime took; with --align "
-                  "each file is cued with its words and followed (at --follow-lag, default "
-                  "[live] follow_lag), with --adapt-speaker the service's show voice learns "
-                  "each line after it. Takes --templates, the front end's options (--class-bias, "
-                  "--lag, ...) and the runtime options; with none given the front end runs as "
-                  "lipsyncd runs it, and the aligner always does");
+    auto* live = cmd->add_flag(
+        "--live", o->live,
+        "Score the service's live path instead: each file fed to lipsyncd's live input "
+        "10 ms at a time (its front end, the runtime in its causal mode, the heard jaw "
+        "and loudness as live), the schedule being what the runtime took; with --align "
+        "each file is cued with its words and followed (at --follow-lag, default "
+        "[live] follow_lag), with --adapt-speaker the service's show voice learns "
+        "each line after it. Takes --templates, the front end's options (--class-bias, "
+        "--lag, ...) and the runtime options, with none given running as lipsyncd runs; "
+        "the aligner runs as lipsyncd runs it, and its options are refused");
     o->aligner.addTo(*cmd, "With --align");
     cmd->add_flag("--adapt-speaker", o->adaptSpeaker,
                   "Carry each speaker's voice from file to file, in name order, as over a show's "
@@ -700,7 +701,10 @@ void addEvalCommand(CLI::App& app) {
                     "With --adapt-speaker: each file also trains the speaker's class and jaw "
                     "networks further on its placed frames, this many passes (0: the set's "
                     "networks stay)",
-                    0, 100);
+                    0, 100)
+        ->excludes(live);
+    // The live path aligns as lipsyncd does: an aligner option there would be silently lost.
+    for (auto* option : o->aligner.added) option->excludes(live);
     o->frontEnd.addTo(*cmd);
     o->runtime.addTo(*cmd, false);
     cmd->callback([o] { runEval(*o); });

@@ -8,9 +8,9 @@
 namespace lipsyncd::cli {
 
 template <class T, class Bound>
-void addNumberOption(CLI::App& cmd, const std::string& name, T& field, const std::string& help,
-                     Bound lo, Bound hi) {
-    cmd.add_option(name, field, help)->check(CLI::Range(lo, hi))->capture_default_str();
+CLI::Option* addNumberOption(CLI::App& cmd, const std::string& name, T& field,
+                             const std::string& help, Bound lo, Bound hi) {
+    return cmd.add_option(name, field, help)->check(CLI::Range(lo, hi))->capture_default_str();
 }
 
 }  // namespace lipsyncd::cli

@@ -108,7 +108,8 @@ TEST(AlignCli, EvalLiveScoresTheServicesLivePath) {
 
 // The front end's options reach the live path (they were once left at lipsyncd's defaults):
 // a class favoured by 12 dB takes the line's frames live as it does offline. Live input cannot
-// wait for the whole file, so --offline decoding is refused.
+// wait for the whole file, so --offline decoding is refused; the live path aligns as lipsyncd
+// does, so an aligner option is refused rather than lost.
 TEST(AlignCli, EvalLiveTakesTheFrontEndsOptions) {
     const auto dir = scratchDir("cli_eval_live_options");
     const std::string en = "Seven puppets sang a song about the moon.";
@@ -127,6 +128,11 @@ TEST(AlignCli, EvalLiveTakesTheFrontEndsOptions) {
     const auto offline = runLipsync({"eval", "--corpus", dir.string(), "--live", "--offline"});
     EXPECT_EQ(offline.exitCode, 1);
     EXPECT_NE(offline.err.find("--live with --offline"), std::string::npos) << offline.err;
+    const auto aligner =
+        runLipsync({"eval", "--corpus", dir.string(), "--live", "--min-word-confidence", "0.5"});
+    EXPECT_EQ(aligner.exitCode, 2);
+    EXPECT_NE(aligner.err.find("--live excludes --min-word-confidence"), std::string::npos)
+        << aligner.err;
 }
 
 TEST(AlignCli, EvalAlignWithoutAnyWordsFileSaysSo) {
