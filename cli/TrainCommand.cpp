@@ -193,6 +193,11 @@ void addTrainCommand(CLI::App& app) {
     addNumberOption(*cmd, "--fine-tune-rate", o->fineTuneRate,
                     "Step size of that training (Adam's; networks are trained anew at 0.001)",
                     1e-6f, 1e-2f);
+    cmd->add_option("--seed", o->training.seed,
+                    "Seed of the k-means++ seeding and of the networks' starting weights and "
+                    "batch order: the same speech and seed give the same set; other seeds show "
+                    "how much of a difference between two recipes is the draw")
+        ->capture_default_str();
     cmd->add_option("--description", o->description, "Description stored in the file");
     cmd->callback([o] {
         auto& a = o->training.analysis;

@@ -584,6 +584,18 @@ TEST(LipsyncCli, TrainKeepTemplatesReplacesOnlyTheNetworksAskedFor) {
         {"train", (dir / "one").string(), "--keep-templates", "default", "-o", out.string()});
     EXPECT_EQ(r.exitCode, 1) << r.err;
     EXPECT_NE(r.err.find("too little labelled speech"), std::string::npos) << r.err;
+
+    // --seed: the same speech and seed give the same network, another seed another draw.
+    const auto jawWith = [&](const std::string& seed) {
+        const auto file = dir.parent_path() / ("seed-" + seed + ".json");
+        const auto t = runLipsync({"train", dir.string(), "--keep-templates", "default",
+                                   "--jaw-hidden", "8", "--class-hidden", "0", "--seed", seed,
+                                   "-o", file.string()});
+        EXPECT_EQ(t.exitCode, 0) << t.err;
+        return dsp::TemplateSet::load(file).jawNetwork->hiddenWeights;
+    };
+    EXPECT_EQ(jawWith("1"), jawWith("1"));
+    EXPECT_NE(jawWith("1"), jawWith("2"));
 }
 
 // train --keep-templates --fine-tune-epochs: the set's own networks trained further on the speech
