@@ -22,21 +22,25 @@
 #   -o OUT.json           write OUT.json instead of the shipped file
 #   --no-fetch            use the real speech already in $REAL_SPEECH_DIR (default build/real-
 #                         speech) instead of fetching and labelling it again (minutes)
+#   --seed N              draw the templates' and networks' start from seed N (`lipsync train
+#                         --seed`; default 1): one recipe over several seeds shows what is the
+#                         recipe's and what is the draw's (the networks' bilabials vary by 2x)
 #
 # The networks (the jaw and the class heard from each frame: config/templates/README.md) are
 # trained on the same speech, with `lipsync train --keep-templates`, which leaves the templates
 # as they are.
 # The set it writes has no class bias (class_bias_db); the shipped one's is fitted afterwards on
-# the tune voices, which no set is trained on:
+# the tune voices, which no set is trained on, from files and through the live path (whose mouth
+# has no dips of the jaw to make up for bilabials a draw does not hear):
 #   scripts/fit-class-bias.py --set config/templates/default.json \
-#       --corpus build/real-speech/tune --write
+#       --corpus build/real-speech/tune --live-too --write
 set -euo pipefail
 usage() {
   echo "usage: scripts/train-templates.sh [--networks-only] [--channel-normalised]" \
-    "[--leave-out SPEAKER]... [-o OUT.json] [--no-fetch]" >&2
+    "[--leave-out SPEAKER]... [-o OUT.json] [--no-fetch] [--seed N]" >&2
   exit 2
 }
-networks_only=0 normalised=0 out="" fetch=1 leave_out=()
+networks_only=0 normalised=0 out="" fetch=1 leave_out=() seed=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --networks-only) networks_only=1 ;;
@@ -44,6 +48,7 @@ while [ $# -gt 0 ]; do
     --leave-out) [ $# -ge 2 ] || usage; leave_out+=("$2"); shift ;;
     -o) [ $# -ge 2 ] || usage; out="$2"; shift ;;
     --no-fetch) fetch=0 ;;
+    --seed) [ $# -ge 2 ] && [[ "$2" =~ ^[0-9]+$ ]] || usage; seed=(--seed "$2"); shift ;;
     -h|--help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;;
     *) usage ;;
   esac
@@ -108,7 +113,7 @@ done
 template_folders=()
 if [ ${#by_aligner[@]} -gt 0 ]; then
   labeller="$real/labeller-templates.json"
-  "$lipsync" train "${folders[@]}" --clusters 24 --jaw-hidden 0 --class-hidden 0 -o "$labeller" \
+  "$lipsync" train ${seed[@]+"${seed[@]}"} "${folders[@]}" --clusters 24 --jaw-hidden 0 --class-hidden 0 -o "$labeller" \
     --description "Labeller: scripts/train-templates.sh's templates from labelled speech only"
   for pair in "${by_aligner[@]}"; do
     where="${pair%%=*}" speaker="${where#*/}"
@@ -145,7 +150,7 @@ out="${out:-$shipped}"
 # --networks-only keeps the shipped set's templates: a new -o file starts as a copy of it.
 [ "$networks_only" = 0 ] || [ -e "$out" ] || cp "$shipped" "$out"
 if [ "$networks_only" = 0 ]; then
-  "$lipsync" train "${folders[@]}" "${template_folders[@]+"${template_folders[@]}"}" --clusters 24 "${channel[@]}" --jaw-hidden 0 --class-hidden 0 \
+  "$lipsync" train ${seed[@]+"${seed[@]}"} "${folders[@]}" "${template_folders[@]+"${template_folders[@]}"}" --clusters 24 "${channel[@]}" --jaw-hidden 0 --class-hidden 0 \
     -o "$out" --description "$kind: trained by scripts/train-templates.sh on $about ($detail)"
 fi
 # The networks also hear the `networks` speakers (tuxpaint's readers in five languages: an hour of
@@ -164,6 +169,6 @@ fi
 description="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["description"].split(" + jaw network")[0])' "$out")"
 networks_about="jaw network (32 units) and class network (64 units) on the same speech, espeak-ng's four times"
 [ ${#network_speakers[@]} -eq 0 ] || networks_about="$networks_about, and on ${network_speakers[*]}"
-"$lipsync" train "$corpus" "$corpus" "${folders[@]}" "${network_folders[@]+"${network_folders[@]}"}" \
+"$lipsync" train ${seed[@]+"${seed[@]}"} "$corpus" "$corpus" "${folders[@]}" "${network_folders[@]+"${network_folders[@]}"}" \
   --keep-templates "$out" --jaw-hidden 32 --jaw-epochs 4 --class-hidden 64 --class-epochs 4 -o "$out" \
   --description "$description + $networks_about"

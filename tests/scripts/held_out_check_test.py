@@ -122,6 +122,18 @@ class HeldOutCheck(unittest.TestCase):
         self.assertIn("espeak-ng dev, full set: 75.0 %", result.stdout)
         self.assertFalse((ROOT / "config" / "templates" / "all.json").exists())
 
+    def test_a_seed_reaches_every_training(self):
+        out = self.root / "seeded.json"
+        result = self.run_script(TRAIN, "--no-fetch", "--seed", "7", "-o", str(out))
+        self.assertEqual(result.returncode, 0, result.stderr)
+        trainings = [c for c in self.log.read_text().splitlines() if c.startswith("train ")]
+        self.assertGreaterEqual(len(trainings), 2)  # the templates, then the networks
+        for call in trainings:
+            self.assertIn("--seed 7 ", call + " ")
+        result = self.run_script(TRAIN, "--seed", "seven")
+        self.assertEqual(result.returncode, 2)
+        self.assertIn("usage: scripts/train-templates.sh", result.stderr)
+
     def test_missing_real_speech_is_named(self):
         self.env["REAL_SPEECH_DIR"] = str(self.root / "nowhere")
         result = self.run_script(CHECK, "--no-fetch", "--work", str(self.root / "work"))
