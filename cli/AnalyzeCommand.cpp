@@ -14,13 +14,6 @@ namespace lipsyncd::cli {
 
 namespace {
 // How frames were decided, for the summary line (the lag is part of the live latency).
-std::string decoderNote(const dsp::DecoderConfig& d) {
-    if (!d.enabled) return "frame by frame";
-    if (d.lagSeconds < 0) return "decoded offline";
-    return "decoder lag " + std::to_string(static_cast<int>(std::lround(d.lagSeconds * 1000))) +
-           " ms";
-}
-
 struct AnalyzeOptions {
     std::string input;
     std::string schedule;
@@ -76,8 +69,8 @@ void runAnalyze(const AnalyzeOptions& o) {
         std::cerr << "lipsync analyze: " << o.input << ": " << std::fixed << std::setprecision(2)
                   << result.durationSeconds << " s at " << result.inputRate << " Hz, "
                   << result.schedule.size() << " segments (resampler delay " << std::setprecision(1)
-                  << result.resamplerDelaySeconds * 1000 << " ms, "
-                  << decoderNote(o.frontEnd.decoder) << ")\n";
+                  << result.resamplerDelaySeconds * 1000 << " ms, " << o.frontEnd.decoderNote()
+                  << ")\n";
     if (!o.schedule.empty())
         withOutputStream(o.schedule, [&](std::ostream& out) {
             if (o.format == "json")

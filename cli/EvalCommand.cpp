@@ -440,6 +440,7 @@ struct Report {
 nlohmann::json toJson(const Report& report, const PhonemeSet& set, const EvalOptions& o) {
     auto j = scoreJson(report.total, o);
     if (o.jaw) j["puppet"] = o.puppet;
+    j["decoder"] = o.frontEnd.decoderNote();
     for (const auto& f : report.files) {
         auto row = scoreJson(f.score, o);
         row["name"] = f.name;
@@ -523,7 +524,9 @@ void printReport(std::ostream& out, const Report& report, const PhonemeSet& set,
         << pct(report.total.schedule.accuracy()) << " (common set), "
         << pct(report.total.schedule.groupAccuracy()) << " (visual groups); worst speaker "
         << group.first << ' ' << pct(group.second)
-        << (o.align ? " (" + made.substr(1) + " on the words" + lag + ")" : "") << '\n';
+        << (o.align ? " (" + made.substr(1) + " on the words" + lag + ")"
+                    : " (from audio, " + o.frontEnd.decoderNote() + (o.live ? ", live path)" : ")"))
+        << '\n';
     if (o.jaw) {
         const auto audio = worst(report, [](const Score& s) { return s.jaw.audio.r(); });
         const auto labels = worst(report, [](const Score& s) { return s.jaw.labels.r(); });

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <lipsyncd/dsp.hpp>
 #include <optional>
 #include <string>
@@ -109,6 +110,12 @@ struct FrontEndOptions {
         return set;
     }
     dsp::DecodeOptions decode() const { return {channel}; }
+    // How classes were decided, for a report: the streaming lag is part of what was measured.
+    std::string decoderNote() const {
+        if (!decoder.enabled) return "frame by frame";
+        if (decoder.lagSeconds < 0) return "decoded offline";
+        return "decoder lag " + std::to_string(std::lround(decoder.lagSeconds * 1000)) + " ms";
+    }
     std::optional<dsp::RawFormat> raw() const {
         if (rawSpec.empty()) return std::nullopt;
         return dsp::RawFormat::parse(rawSpec);

@@ -125,6 +125,14 @@ TEST(AlignCli, EvalLiveTakesTheFrontEndsOptions) {
     const double asShipped = groups({}), bilabials = groups({"--class-bias", "bmp=-12"});
     EXPECT_GT(asShipped, 0.6);
     EXPECT_LT(bilabials, asShipped - 0.2);
+    // The lag the classes were decided at is part of the figure (issue 10: its lag stated).
+    const auto lagged =
+        runLipsync({"eval", "--corpus", dir.string(), "--live", "--lag", "0.1", "--json", "-"});
+    ASSERT_EQ(lagged.exitCode, 0) << lagged.err;
+    EXPECT_NE(lagged.out.find("(from audio, decoder lag 100 ms, live path)"), std::string::npos)
+        << lagged.out;
+    EXPECT_EQ(nlohmann::json::parse(lagged.out.substr(lagged.out.find("\n{") + 1))["decoder"],
+              "decoder lag 100 ms");
     const auto offline = runLipsync({"eval", "--corpus", dir.string(), "--live", "--offline"});
     EXPECT_EQ(offline.exitCode, 1);
     EXPECT_NE(offline.err.find("--live with --offline"), std::string::npos) << offline.err;
