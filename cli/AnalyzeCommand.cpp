@@ -13,7 +13,6 @@
 namespace lipsyncd::cli {
 
 namespace {
-// How frames were decided, for the summary line (the lag is part of the live latency).
 struct AnalyzeOptions {
     std::string input;
     std::string schedule;

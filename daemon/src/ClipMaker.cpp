@@ -25,6 +25,7 @@ struct ClipMaker::Impl {
     DaemonConfig config;
     lipsync::Runtime runtime;  // built as `lipsync animate` builds it
     dsp::TemplateSet templates;
+    dsp::FrontEndConfig frontEnd;  // the defaults, unless `lipsync eval --live` set its own
     std::vector<std::string> poseNames;
     std::shared_ptr<ShowSpeaker> speaker;  // null: adapt_speaker = false
 
@@ -32,6 +33,7 @@ struct ClipMaker::Impl {
         : config(c),
           runtime(c.runtime),
           templates(c.templateSet ? *c.templateSet : dsp::TemplateSet::named(c.templates)),
+          frontEnd(c.frontEnd ? *c.frontEnd : dsp::FrontEndConfig{}),
           poseNames(runtime.poses().names()) {}
 };
 
@@ -60,11 +62,6 @@ ShowSpeaker* ClipMaker::speaker() const {
 
 const std::vector<std::string>& ClipMaker::poseNames() const {
     return impl_->poseNames;
-}
-
-const dsp::FrontEndConfig& ClipMaker::frontEnd() const {
-    static const dsp::FrontEndConfig defaults;
-    return impl_->config.frontEnd ? *impl_->config.frontEnd : defaults;
 }
 
 namespace {
@@ -165,8 +162,8 @@ ClipMaker::LineLesson ClipMaker::learnFromLine(
     auto lesson = impl_->speaker->startLesson();
     dsp::AlignFileResult r;
     try {
-        r = alignText(synth, wav.path(), text, impl_->config.voice, impl_->templates, frontEnd(),
-                      {}, {}, std::nullopt, true, &lesson.voice);
+        r = alignText(synth, wav.path(), text, impl_->config.voice, impl_->templates,
+                      impl_->frontEnd, {}, {}, std::nullopt, true, &lesson.voice);
     } catch (const InputError& e) {
         return {false, wav.named(e.what(), name)};
     }
@@ -189,7 +186,7 @@ std::unique_ptr<ClipMaker::Live> ClipMaker::startLive(int rate) const {
     // Live input follows the show's voice as the lines with words before it taught it.
     const auto& templates = impl_->speaker ? impl_->speaker->templates() : impl_->templates;
     return std::make_unique<StreamingLive>(templates, impl_->runtime, rate,
-                                           impl_->config.followLagSeconds, frontEnd());
+                                           impl_->config.followLagSeconds, impl_->frontEnd);
 }
 
 std::vector<dsp::ScriptWord> ClipMaker::readLine(const std::string& text,

@@ -208,7 +208,6 @@ class ClipMaker {
     std::unique_ptr<Live> startLive(int rate) const;
 
   private:
-    const dsp::FrontEndConfig& frontEnd() const;
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
