@@ -77,6 +77,8 @@ struct Evaluator {
     const EvalOptions& o;
     const PhonemeSet& set = PhonemeSet::common();
     dsp::TemplateSet templates = o.frontEnd.loadTemplates();
+    // Built once: --transitions is a file read, and every file is analysed with the same.
+    dsp::FrontEndConfig frontEndConfig = o.frontEnd.config();
     lipsync::Runtime runtime = o.runtime.load();
     std::optional<PuppetJaw> puppet;
     std::unique_ptr<EspeakSynthesizer> synth;  // --align, --adapt-speaker: reads the words
@@ -178,7 +180,7 @@ struct Evaluator {
         try {
             auto r =
                 alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
-                          voiceFor(item.speaker), templates, o.frontEnd.config(), o.aligner.config,
+                          voiceFor(item.speaker), templates, frontEndConfig, o.aligner.config,
                           o.frontEnd.decode(), std::nullopt, o.aligner.reductions, speaker);
             for (const auto& w : r.warnings) std::cerr << where(item) << w << '\n';
             return r;
@@ -196,7 +198,7 @@ struct Evaluator {
                                                    dsp::SpeakerAdaptation* speaker,
                                                    bool teach) const {
         const auto own = learnt(speaker);
-        auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, o.frontEnd.config(),
+        auto a = dsp::analyzeFile(item.audio, own ? *own : templates, set, frontEndConfig,
                                   o.frontEnd.decode(), std::nullopt);
         printWarnings("eval", a.warnings);
         if (teach && speaker && wordsBeside(item.audio)) align(item, speaker);
@@ -212,7 +214,7 @@ struct Evaluator {
         try {
             auto a = followText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
                                 voiceFor(item.speaker), own ? *own : templates, o.followLag,
-                                o.frontEnd.config(), o.aligner.config, o.frontEnd.decode(),
+                                frontEndConfig, o.aligner.config, o.frontEnd.decode(),
                                 o.aligner.reductions);
             printWarnings("eval", a.warnings);
             if (speaker) align(item, speaker);
@@ -234,7 +236,7 @@ struct Evaluator {
         c.templates = o.frontEnd.templates;
         // The front end as the options set it, not the service's defaults: a --class-bias or a
         // --min-vowel measured live must reach the live path.
-        c.frontEnd = std::make_shared<const dsp::FrontEndConfig>(o.frontEnd.config());
+        c.frontEnd = std::make_shared<const dsp::FrontEndConfig>(frontEndConfig);
         c.templateSet = std::make_shared<const dsp::TemplateSet>(templates);
         c.runtime = o.runtime.spec;
         c.voice = voiceFor(speaker);
