@@ -92,6 +92,15 @@ struct FrontEndOptions {
         cmd.add_flag_callback(
             "--offline", [this] { decoder.lagSeconds = -1; },
             "Decode offline: every frame decided from the whole input (files only)");
+        addNumberOption(cmd, "--group-share", decoder.groupShare,
+                        "How much a class pays for the share of the frame its visual group "
+                        "lacks against the likeliest group's (the group decided by all its "
+                        "classes together before the class; 0: the nearest class alone)",
+                        0.0, 100.0);
+        addNumberOption(cmd, "--group-spread", decoder.groupSpreadDb,
+                        "dB of distance over which a class's weight in its group's share falls "
+                        "by a factor e",
+                        0.05, 20.0);
         cmd.add_option("--transitions", transitions,
                        "Class transition model (JSON; default: "
                        "config/decoder/english-transitions.json)");

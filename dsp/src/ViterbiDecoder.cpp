@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <lipsyncd/dsp.hpp>
+#include <string_view>
 
 #include "ClassEntry.hpp"
 
@@ -47,6 +48,17 @@ ViterbiDecoder::ViterbiDecoder(const TransitionModel& model, const PhonemeSet& s
         lastState_.push_back(static_cast<int>(stateClass_.size()) - 1);
     }
     states_ = stateClass_.size();
+    if (!(config.groupSpreadDb > 0))
+        throw InputError("decoder: the group spread must be above 0 dB");
+    std::vector<std::string_view> groups;  // speech groups, in first-seen order
+    classGroup_.assign(classes_, -1);
+    for (std::size_t c = 0; c < classes_; ++c) {
+        if (static_cast<int>(c) == sil_) continue;
+        auto at = std::find(groups.begin(), groups.end(), set[c].group);
+        if (at == groups.end()) at = groups.insert(groups.end(), set[c].group);
+        classGroup_[c] = static_cast<int>(at - groups.begin());
+    }
+    groupMass_.assign(groups.size(), 0.0f);
     score_.assign(states_, kUnreachable);
     next_.assign(states_, kUnreachable);
     emission_.assign(classes_, 0.0f);
@@ -84,6 +96,8 @@ void ViterbiDecoder::step(const FrameLabel& label, std::span<const float> distan
             emission_[c] = above + (label.silent ? config_.gatedSpeechPenalty : 0.0f);
     }
 
+    addGroupCosts(distances, best);
+
     const std::size_t slot = lag_ >= 0 ? frames_ % static_cast<std::size_t>(lag_ + 1) : frames_;
     if (lag_ < 0) back_.resize((frames_ + 1) * states_);
     std::uint16_t* back = back_.data() + slot * states_;
@@ -119,6 +133,27 @@ void ViterbiDecoder::step(const FrameLabel& label, std::span<const float> distan
     const float low = *std::min_element(next_.begin(), next_.end());
     for (std::size_t s = 0; s < states_; ++s) score_[s] = std::min(next_[s] - low, kUnreachable);
     ++frames_;
+}
+
+// Robust decisions before fine ones: the visual group a frame most likely shows is decided by
+// all of its classes together, not by its single nearest class. A group's share of the frame is
+// Σ exp(−(d − d_best) / spread) over its classes (d in dB; the class network's nats count 1 dB
+// each, ClassifierConfig::classNetworkDb), and every speech class pays share · spread ·
+// ln(top share / its group's share): nothing in the likeliest group. Silence keeps the energy
+// gate's vote alone.
+void ViterbiDecoder::addGroupCosts(std::span<const float> distances, float best) {
+    if (!(config_.groupShare > 0) || groupMass_.empty() || !std::isfinite(best)) return;
+    std::fill(groupMass_.begin(), groupMass_.end(), 0.0f);
+    for (std::size_t c = 0; c < classes_ && c < distances.size(); ++c)
+        if (classGroup_[c] >= 0 && std::isfinite(distances[c]))
+            groupMass_[classGroup_[c]] += std::exp(-(distances[c] - best) / config_.groupSpreadDb);
+    const float top = *std::max_element(groupMass_.begin(), groupMass_.end());
+    const float scale = config_.groupShare * config_.groupSpreadDb * config_.distanceScale;
+    for (float& m : groupMass_)  // now each group's cost: a logarithm per group, not per class
+        m = m > 0 ? scale * std::log(top / m) : 0.0f;
+    for (std::size_t c = 0; c < classes_; ++c)
+        if (classGroup_[c] >= 0 && emission_[c] < kUnreachable)
+            emission_[c] += groupMass_[classGroup_[c]];
 }
 
 // The state at frame (frames_ − 1 − frameOffset) on the best path ending now.

@@ -166,3 +166,35 @@ TEST(TransitionModel, BadFilesAreRefusedNamingTheField) {
     EXPECT_NE(errorOf(R"({"format": "other", "version": 1})").find("format"), std::string::npos);
     std::filesystem::remove(path);
 }
+
+TEST(ViterbiDecoder, AFrameShowsTheVisualGroupItsClassesTogetherFavour) {
+    // The rounded 'ao' is nearest, but two open vowels lie just behind it: together the open
+    // group is likelier, and the mouth should open.
+    auto in = frames({{"sil", 5}, {"ao", 12}, {"sil", 5}});
+    for (std::size_t i = 5; i < 17; ++i) {
+        in[i].distances.assign(set().size(), 9.0f);
+        in[i].distances[static_cast<std::size_t>(id("ao"))] = 4.0f;
+        in[i].distances[static_cast<std::size_t>(id("aa"))] = 4.2f;
+        in[i].distances[static_cast<std::size_t>(id("ah"))] = 4.4f;
+    }
+    const auto run = [&](float groupShare) {
+        dsp::DecoderConfig config;
+        config.groupShare = groupShare;
+        dsp::ViterbiDecoder decoder(uniformModel(3), set(), 0.01, config);
+        std::vector<std::string> out;
+        for (const auto& f : in)
+            for (const auto& l : decoder.push(f.label, f.distances))
+                out.push_back(set()[static_cast<std::size_t>(l.phoneme)].name);
+        for (const auto& l : decoder.finish())
+            out.push_back(set()[static_cast<std::size_t>(l.phoneme)].name);
+        return out;
+    };
+    EXPECT_EQ(run(dsp::DecoderConfig{}.groupShare), names({{"sil", 5}, {"aa", 12}, {"sil", 5}}));
+    EXPECT_EQ(run(0), names({{"sil", 5}, {"ao", 12}, {"sil", 5}}));  // the nearest class alone
+}
+
+TEST(ViterbiDecoder, AGroupSpreadOfZeroIsRefused) {
+    dsp::DecoderConfig config;
+    config.groupSpreadDb = 0;
+    EXPECT_THROW(dsp::ViterbiDecoder(uniformModel(3), set(), 0.01, config), InputError);
+}
