@@ -46,9 +46,8 @@ std::vector<Frame> frames(const std::vector<std::pair<std::string, int>>& runs) 
     return out;
 }
 
-std::vector<std::string> decode(const std::vector<Frame>& in, double lag, int minFrames = 3) {
-    dsp::DecoderConfig config;
-    config.lagSeconds = lag;
+std::vector<std::string> decodeWith(const std::vector<Frame>& in, const dsp::DecoderConfig& config,
+                                    int minFrames = 3) {
     dsp::ViterbiDecoder decoder(uniformModel(minFrames), set(), 0.01, config);
     std::vector<std::string> out;
     for (const auto& f : in)
@@ -57,6 +56,12 @@ std::vector<std::string> decode(const std::vector<Frame>& in, double lag, int mi
     for (const auto& l : decoder.finish())
         out.push_back(set()[static_cast<std::size_t>(l.phoneme)].name);
     return out;
+}
+
+std::vector<std::string> decode(const std::vector<Frame>& in, double lag, int minFrames = 3) {
+    dsp::DecoderConfig config;
+    config.lagSeconds = lag;
+    return decodeWith(in, config, minFrames);
 }
 
 std::vector<std::string> names(const std::vector<std::pair<std::string, int>>& runs) {
@@ -180,14 +185,7 @@ TEST(ViterbiDecoder, AFrameShowsTheVisualGroupItsClassesTogetherFavour) {
     const auto run = [&](float groupShare) {
         dsp::DecoderConfig config;
         config.groupShare = groupShare;
-        dsp::ViterbiDecoder decoder(uniformModel(3), set(), 0.01, config);
-        std::vector<std::string> out;
-        for (const auto& f : in)
-            for (const auto& l : decoder.push(f.label, f.distances))
-                out.push_back(set()[static_cast<std::size_t>(l.phoneme)].name);
-        for (const auto& l : decoder.finish())
-            out.push_back(set()[static_cast<std::size_t>(l.phoneme)].name);
-        return out;
+        return decodeWith(in, config);
     };
     EXPECT_EQ(run(dsp::DecoderConfig{}.groupShare), names({{"sil", 5}, {"aa", 12}, {"sil", 5}}));
     EXPECT_EQ(run(0), names({{"sil", 5}, {"ao", 12}, {"sil", 5}}));  // the nearest class alone
