@@ -17,6 +17,7 @@
 #include "Output.hpp"
 #include "PuppetJaw.hpp"
 #include "RuntimeOptions.hpp"
+#include "UnusedWordsLog.hpp"
 
 namespace lipsyncd::cli {
 
@@ -86,6 +87,8 @@ struct Evaluator {
     mutable std::map<std::string, dsp::SpeakerAdaptation> speakers;
     // --live: each speaker's service pieces (its show voice, with --adapt-speaker).
     mutable std::map<std::string, std::unique_ptr<daemon::ClipMaker>> liveMakers;
+    // Files whose words could not be used: the first of each speaker told, the rest counted.
+    mutable UnusedWordsLog unusedWords;
 
     explicit Evaluator(const EvalOptions& options) : o(options) {
         if (o.jaw) puppet.emplace(output::Puppet::named(o.puppet), o.jawActuator);
@@ -142,6 +145,18 @@ struct Evaluator {
         return voice;
     }
 
+    // Said with a speaker's first file whose words could not be used, when no --voice names
+    // that speaker: the voice that read them, and how to give another.
+    std::string voiceHint(const std::string& speaker) const {
+        for (const auto& v : o.voices)
+            if (v.starts_with(speaker + '=')) return "";
+        return "--voice " + speaker + "=LANG reads this speaker's words in its language";
+    }
+
+    void wordsNotUsed(const CorpusItem& item, const std::string& why) const {
+        unusedWords.add(std::cerr, item.speaker, where(item), why, voiceHint(item.speaker));
+    }
+
     // The schedule under test and the levels the runtime opens the jaw by: aligned on the
     // words beside the file (--align), else analysed from the audio alone.
     std::pair<PhonemeSchedule, LevelTrack> schedule(const CorpusItem& item) const {
@@ -178,14 +193,14 @@ struct Evaluator {
     std::optional<dsp::AlignFileResult> align(const CorpusItem& item,
                                               dsp::SpeakerAdaptation* speaker) const {
         try {
-            auto r =
-                alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
-                          voiceFor(item.speaker), templates, frontEndConfig, o.aligner.config,
-                          o.frontEnd.decode(), std::nullopt, o.aligner.reductions, speaker);
+            auto r = alignText(*synth, item.audio, readTextFile(*wordsBeside(item.audio)),
+                               voiceFor(item.speaker), templates, frontEndConfig, o.aligner.config,
+                               o.frontEnd.decode(), std::nullopt, o.aligner.reductions, speaker);
             for (const auto& w : r.warnings) std::cerr << where(item) << w << '\n';
             return r;
         } catch (const InputError& e) {
-            std::cerr << where(item) << "words not used: " << e.what() << "; audio-only analysis\n";
+            wordsNotUsed(item,
+                         std::string("words not used: ") + e.what() + "; audio-only analysis");
             return std::nullopt;
         }
     }
@@ -220,7 +235,8 @@ struct Evaluator {
             if (speaker) align(item, speaker);
             return std::pair(std::move(a.schedule), std::move(a.levels));
         } catch (const InputError& e) {
-            std::cerr << where(item) << "words not used: " << e.what() << "; audio-only analysis\n";
+            wordsNotUsed(item,
+                         std::string("words not used: ") + e.what() + "; audio-only analysis");
             return std::nullopt;
         }
     }
@@ -267,7 +283,7 @@ struct Evaluator {
             try {
                 path->follow(maker.readLine(text, *synth), mouth);
             } catch (const InputError& e) {
-                std::cerr << where(item) << "words not followed: " << e.what() << '\n';
+                wordsNotUsed(item, std::string("words not followed: ") + e.what());
             }
         }
         const auto block = static_cast<std::size_t>(audio.sampleRate / 100);
@@ -607,6 +623,7 @@ void runEval(const EvalOptions& o) {
         report.speakers[item.speaker].add(report.files.back().score);
         report.total.add(report.files.back().score);
     }
+    evaluator.unusedWords.summarise(std::cerr, "lipsync eval");
     printReport(std::cout, report, evaluator.set, o);
     if (!o.json.empty())
         withOutputStream(o.json, [&](std::ostream& out) {
@@ -669,11 +686,12 @@ void addEvalCommand(CLI::App& app) {
                     "--align), 0..1, rise above this")
         ->check(CLI::Range(0.0, 1.0));
     cmd->add_flag("!--no-per-file", o->perFile, "Leave out the per-file table");
-    auto* align = cmd->add_flag("--align", o->align,
-                  "Score 'lipsync align' instead: each NAME.wav aligned on the words of NAME.txt "
-                  "beside it (files without one are skipped); the jaw 'audio' column is then "
-                  "the aligned schedule's, and each speaker's boundaries are timed against the "
-                  "labels' (median error, share within 20 and 50 ms, missed)");
+    auto* align = cmd->add_flag(
+        "--align", o->align,
+        "Score 'lipsync align' instead: each NAME.wav aligned on the words of NAME.txt "
+        "beside it (files without one are skipped); the jaw 'audio' column is then "
+        "the aligned schedule's, and each speaker's boundaries are timed against the "
+        "labels' (median error, share within 20 and 50 ms, missed)");
     cmd->add_option("--voice", o->voices,
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");

@@ -63,6 +63,26 @@ TEST(AlignCli, EvalAlignScoresTheAlignedWordsPerSpeakerAndVoice) {
     }
 }
 
+// A speaker whose words the voice cannot read: the first file says why and which option helps,
+// the others are counted once at the end, not told one by one.
+TEST(AlignCli, EvalTellsWordsItCannotUseOnceForEachSpeaker) {
+    const auto dir = scratchDir("cli_eval_unused_words");
+    const std::string ru = "Она завела прядь волос за ухо.";
+    for (const auto* name : {"one", "two", "three"}) speak(dir / "ivan", name, ru, "ru", ru);
+    const auto r = runLipsync({"eval", "--corpus", dir.string(), "--align", "--no-per-file"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto first = r.err.find("words not used");
+    ASSERT_NE(first, std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("words not used", first + 1), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--voice ivan=LANG"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("ivan: the words of 3 files not used"), std::string::npos) << r.err;
+    // Given the speaker's language, nothing to tell.
+    const auto right =
+        runLipsync({"eval", "--corpus", dir.string(), "--align", "--voice", "ivan=ru"});
+    ASSERT_EQ(right.exitCode, 0) << right.err;
+    EXPECT_EQ(right.err.find("not used"), std::string::npos) << right.err;
+}
+
 // `--follow-lag`: each file followed as lipsyncd follows a live line with its words; the
 // report says so and names the lag, and the option means nothing without --align.
 TEST(AlignCli, EvalFollowLagScoresLinesAsTheServiceFollowsThem) {

@@ -290,6 +290,19 @@ TEST(AlignText, TextInAScriptTheVoiceCannotReadIsAnError) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("no words"), std::string::npos) << e.what();
     }
+    // A paragraph is quoted on one line, and cut short.
+    try {
+        align(file,
+              "Покалывало грудь,\nстучала кровь в виски, но дышалось легко, - воздух был "
+              "тонок и сух.\n");
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        EXPECT_NE(what.find("'Покалывало грудь, стучала"), std::string::npos) << what;
+        EXPECT_NE(what.find("…'"), std::string::npos) << what;
+        EXPECT_EQ(what.find("сух"), std::string::npos) << what;
+    }
     // Mixed: the readable words are aligned, the others left to audio-only analysis.
     const auto r = align(file, "Seven puppets Привет sang a song about the moon.");
     EXPECT_GE(placed(r), 6u);

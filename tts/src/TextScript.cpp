@@ -60,6 +60,27 @@ PhonemeSchedule mapPhonemes(const SpokenWord& spoken, const PhonemeSchedule& pho
     return out;
 }
 
+// Text as an error message quotes it: on one line, and no longer than a line of a terminal (a
+// words file can hold a paragraph).
+std::string quotedInMessage(const std::string& text) {
+    constexpr std::size_t kMostCodePoints = 60;
+    std::string out;
+    std::size_t shown = 0;
+    bool space = false;
+    for (const char32_t c : utf8::codePoints(text)) {
+        if (c < 0x80 && std::isspace(static_cast<int>(c))) {
+            space = !out.empty();
+            continue;
+        }
+        if (shown + (space ? 1 : 0) >= kMostCodePoints) return "'" + out + "…'";
+        if (space) out += ' ', ++shown;
+        space = false;
+        utf8::append(out, c);
+        ++shown;
+    }
+    return "'" + out + "'";
+}
+
 bool hasSound(const dsp::ScriptWord& w) {
     return std::any_of(w.phonemes.begin(), w.phonemes.end(),
                        [](const PhonemeSegment& p) { return p.phoneme != "sil"; });
@@ -94,8 +115,8 @@ std::vector<dsp::ScriptWord> scriptForText(EspeakSynthesizer& synth, const std::
         script.push_back(std::move(word));
     }
     if (script.empty())
-        throw InputError("espeak-ng (voice '" + voice + "') found no words it can read in '" +
-                         text + "'");
+        throw InputError("espeak-ng (voice '" + voice + "') found no words it can read in " +
+                         quotedInMessage(text));
     return script;
 }
 
