@@ -113,15 +113,20 @@ std::vector<ReadRecording> alignReadSpeech(const CalibrateOptions& o, const dsp:
         const auto& [audio, words] = files[i];
         reportProgress("aligned", i, files.size());
         if (!synth) synth.emplace();
+        const auto skip = [&](const std::string& why) {
+            std::cerr << "lipsync calibrate: skipped " << audio.string() << ": " << why << '\n';
+        };
         auto text = readTextFile(words);
-        const auto aligned = alignText(*synth, audio, text, o.voice, base);
-        if (aligned.fellBack || !aligned.warnings.empty()) {
-            std::cerr << "lipsync calibrate: skipped " << audio.string() << ": "
-                      << (aligned.warnings.empty() ? "not aligned" : aligned.warnings.front())
-                      << '\n';
-            continue;
+        try {
+            const auto aligned = alignText(*synth, audio, text, o.voice, base);
+            if (aligned.fellBack || !aligned.warnings.empty()) {
+                skip(aligned.warnings.empty() ? "not aligned" : aligned.warnings.front());
+                continue;
+            }
+            read.push_back({audio, std::move(text), aligned.schedule});
+        } catch (const InputError& e) {  // words the voice cannot read, say: the others serve
+            skip(words.string() + ": " + e.what());
         }
-        read.push_back({audio, std::move(text), aligned.schedule});
     }
     return read;
 }
@@ -259,6 +264,12 @@ void runCalibrate(const CalibrateOptions& o) {
         printWarnings("calibrate", warnings);
         addOnce(recorded, cls);
     }
+    if (recorded.empty() && read.empty() && synth)  // read speech there was, none aligned
+        throw InputError(o.folder +
+                         ": none of its recordings with words could be aligned (each "
+                         "skipped above; --voice LANG reads the words in another "
+                         "language, now '" +
+                         o.voice + "')");
     if (recorded.empty() && read.empty())
         throw InputError(o.folder +
                          ": no recordings named after a phoneme class, and none with its words "

@@ -412,10 +412,14 @@ TEST(LipsyncCli, CalibrateFromReadSpeechMovesTheClassesItHeard) {
     fs::copy_file(dir / "s1.wav", dir / "s4.wav", fs::copy_options::overwrite_existing);
     std::ofstream(dir / "s4.txt") << "Twenty seven thousand and forty two unexpected "
                                      "mathematicians politely disagreed about everything.\n";
+    // Words the voice cannot read: that file is named and skipped, the others serve.
+    fs::copy_file(dir / "s2.wav", dir / "s5.wav", fs::copy_options::overwrite_existing);
+    std::ofstream(dir / "s5.txt") << "Она завела прядь волос за ухо.\n";
     const auto out = dir.parent_path() / "calibrated-read.json";
     const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("skipped " + (dir / "s4.wav").string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("skipped " + (dir / "s5.wav").string()), std::string::npos) << r.err;
     const auto own = dsp::TemplateSet::load(out);
     const auto base = dsp::TemplateSet::loadDefault();
     ASSERT_EQ(own.classes.size(), base.classes.size());
@@ -488,6 +492,25 @@ double warpOf(const fs::path& templates) {
 
 // With read speech, calibrate chooses the speaker's vocal-tract-length warp: none for the voice
 // the templates know, below 1 for the same lines with every formant 12 % lower.
+// Read speech none of which the voice can read: a clear error that says which option helps.
+TEST(LipsyncCli, CalibrateOnWordsTheVoiceCannotReadSaysWhichVoiceReadThem) {
+    const auto dir = scratchDir("cli_calibrate_unreadable");
+    const std::string ru = "Она завела прядь волос за ухо.";
+    ASSERT_EQ(
+        runLipsync({"say", ru, "--voice", "ru", "--wav", (dir / "line.wav").string()}).exitCode, 0);
+    std::ofstream(dir / "line.txt") << ru << '\n';
+    const auto out = dir / "calibrated.json";
+    const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("skipped " + (dir / "line.wav").string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("none of its recordings with words could be aligned"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("--voice"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_EQ(runLipsync({"calibrate", dir.string(), "-o", out.string(), "--voice", "ru"}).exitCode,
+              0);
+}
+
 TEST(LipsyncCli, CalibrateChoosesAWarpForAVoiceWithLowerFormants) {
     const auto plain = scratchDir("cli_calibrate_warp_plain");
     const auto low = scratchDir("cli_calibrate_warp_low");
@@ -588,9 +611,9 @@ TEST(LipsyncCli, TrainKeepTemplatesReplacesOnlyTheNetworksAskedFor) {
     // --seed: the same speech and seed give the same network, another seed another draw.
     const auto jawWith = [&](const std::string& seed) {
         const auto file = dir.parent_path() / ("seed-" + seed + ".json");
-        const auto t = runLipsync({"train", dir.string(), "--keep-templates", "default",
-                                   "--jaw-hidden", "8", "--class-hidden", "0", "--seed", seed,
-                                   "-o", file.string()});
+        const auto t =
+            runLipsync({"train", dir.string(), "--keep-templates", "default", "--jaw-hidden", "8",
+                        "--class-hidden", "0", "--seed", seed, "-o", file.string()});
         EXPECT_EQ(t.exitCode, 0) << t.err;
         return dsp::TemplateSet::load(file).jawNetwork->hiddenWeights;
     };
