@@ -7,6 +7,7 @@
 #include <lipsyncd/tts.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "AlignerOptions.hpp"
@@ -134,22 +135,25 @@ struct Evaluator {
 
     // The voice whose reading of the words a speaker's files are aligned with.
     std::string voiceFor(const std::string& speaker) const {
+        if (auto own = ownVoice(speaker)) return *own;
         std::string voice = "en-us";
-        for (const auto& v : o.voices) {
-            const auto eq = v.find('=');
-            if (eq == std::string::npos)
-                voice = v;
-            else if (v.substr(0, eq) == speaker)
-                return v.substr(eq + 1);
-        }
+        for (const auto& v : o.voices)
+            if (v.find('=') == std::string::npos) voice = v;
         return voice;
+    }
+
+    // The voice a SPEAKER=VOICE entry of --voice gives this speaker (the first), if any.
+    std::optional<std::string> ownVoice(const std::string& speaker) const {
+        for (const auto& v : o.voices)
+            if (const auto eq = v.find('='); eq != std::string::npos && v.substr(0, eq) == speaker)
+                return v.substr(eq + 1);
+        return std::nullopt;
     }
 
     // Said with a speaker's first file whose words could not be used, when no --voice names
     // that speaker: the voice that read them, and how to give another.
     std::string voiceHint(const std::string& speaker) const {
-        for (const auto& v : o.voices)
-            if (v.starts_with(speaker + '=')) return "";
+        if (ownVoice(speaker)) return "";
         return "--voice " + speaker + "=LANG reads this speaker's words in its language";
     }
 

@@ -462,6 +462,25 @@ TEST(LipsyncCli, CalibrateFromReadSpeechMovesTheClassesItHeard) {
     EXPECT_EQ(same.classNetwork->hiddenWeights, base.classNetwork->hiddenWeights);
 }
 
+// Read speech none of which the voice can read: a clear error that says which option helps.
+TEST(LipsyncCli, CalibrateOnWordsTheVoiceCannotReadSaysWhichVoiceReadThem) {
+    const auto dir = scratchDir("cli_calibrate_unreadable");
+    const std::string ru = "Она завела прядь волос за ухо.";
+    ASSERT_EQ(
+        runLipsync({"say", ru, "--voice", "ru", "--wav", (dir / "line.wav").string()}).exitCode, 0);
+    std::ofstream(dir / "line.txt") << ru << '\n';
+    const auto out = dir / "calibrated.json";
+    const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("skipped " + (dir / "line.wav").string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("none of its recordings with words could be aligned"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("--voice"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_EQ(runLipsync({"calibrate", dir.string(), "-o", out.string(), "--voice", "ru"}).exitCode,
+              0);
+}
+
 // A copy of a WAV file whose header claims `factor` times its sample rate: played slower, its
 // formants lie lower by that factor, as a speaker with a longer vocal tract's do.
 void copyAtRate(const fs::path& from, const fs::path& to, double factor) {
@@ -492,25 +511,6 @@ double warpOf(const fs::path& templates) {
 
 // With read speech, calibrate chooses the speaker's vocal-tract-length warp: none for the voice
 // the templates know, below 1 for the same lines with every formant 12 % lower.
-// Read speech none of which the voice can read: a clear error that says which option helps.
-TEST(LipsyncCli, CalibrateOnWordsTheVoiceCannotReadSaysWhichVoiceReadThem) {
-    const auto dir = scratchDir("cli_calibrate_unreadable");
-    const std::string ru = "Она завела прядь волос за ухо.";
-    ASSERT_EQ(
-        runLipsync({"say", ru, "--voice", "ru", "--wav", (dir / "line.wav").string()}).exitCode, 0);
-    std::ofstream(dir / "line.txt") << ru << '\n';
-    const auto out = dir / "calibrated.json";
-    const auto r = runLipsync({"calibrate", dir.string(), "-o", out.string()});
-    EXPECT_EQ(r.exitCode, 1) << r.err;
-    EXPECT_NE(r.err.find("skipped " + (dir / "line.wav").string()), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("none of its recordings with words could be aligned"), std::string::npos)
-        << r.err;
-    EXPECT_NE(r.err.find("--voice"), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(out));
-    EXPECT_EQ(runLipsync({"calibrate", dir.string(), "-o", out.string(), "--voice", "ru"}).exitCode,
-              0);
-}
-
 TEST(LipsyncCli, CalibrateChoosesAWarpForAVoiceWithLowerFormants) {
     const auto plain = scratchDir("cli_calibrate_warp_plain");
     const auto low = scratchDir("cli_calibrate_warp_low");
