@@ -8,7 +8,7 @@ namespace lipsyncd::dsp {
 
 namespace {
 
-// At most this many words in a row may be skipped (each at skipWordCost).
+// At most this many words in a row may be skipped (each at its own cost: wordSkipCost).
 constexpr int kMaxSkippedInARow = 2;
 // The tail's stay probability is kept in this range: a phoneme may always end, and always stay.
 constexpr double kMinStay = 0.05, kMaxStay = 0.97;
@@ -49,7 +49,7 @@ class GraphBuilder {
     void fromPreviousUnits(int to, std::size_t unit, float cost) {
         for (int skipped = 0; skipped <= maxSkipped_ && skipped < static_cast<int>(unit); ++skipped)
             for (int from : units_[unit - 1 - skipped])
-                edge(from, to, cost + config_.skipWordCost * static_cast<float>(skipped),
+                edge(from, to, cost + skipCost(static_cast<int>(unit) - 1 - skipped, skipped),
                      skipped > 0);
     }
 
@@ -76,7 +76,7 @@ class GraphBuilder {
             for (int from : units_[unit]) edge(from, node, enter);
             for (int s = 1; s <= maxSkipped_ && s <= static_cast<int>(unit); ++s)
                 for (int from : units_[unit - s])  // the words between skipped
-                    edge(from, node, enter + config_.skipWordCost * static_cast<float>(s), true);
+                    edge(from, node, enter + skipCost(static_cast<int>(unit) - s, s), true);
         }
         edge(last, f, 0);  // a pause, then something else; edges only go forward
         const int afterPause = after ? addFillerAfterPause(units_[unit], pause, filler) : -1;
@@ -137,6 +137,7 @@ class GraphBuilder {
             shortest = std::min(shortest, frames);
         }
         graph_.minimumFrames += shortest;
+        wordSkipCost_.push_back(wordSkipCost(word.phonemes));
         units_.push_back(lasts);
         graph_.wordExpectedSeconds.push_back(graph_.expectedSeconds - before);
     }
@@ -211,8 +212,8 @@ class GraphBuilder {
         for (int s = 0; s <= maxSkipped_ && s < static_cast<int>(last) + 1; ++s)
             for (int node : units_[last - s])
                 if (graph_.nodes[node].kind != AlignmentNode::Kind::Start)
-                    graph_.endCost[node] = std::min(graph_.endCost[node],
-                                                    config_.skipWordCost * static_cast<float>(s));
+                    graph_.endCost[node] =
+                        std::min(graph_.endCost[node], skipCost(static_cast<int>(last) - s, s));
         countFramesToEnd();
     }
 
@@ -233,6 +234,24 @@ class GraphBuilder {
         }
     }
 
+    // Skipping `count` words from word `first` on.
+    float skipCost(int first, int count) const {
+        float sum = 0;
+        for (int w = first; w < first + count; ++w) sum += wordSkipCost_[w];
+        return sum;
+    }
+
+    // A long word left out is a long stretch of the speaker's sound given to the words around
+    // it; a short one may be said so fast that it leaves no trace (AlignerConfig::skipPhonemeCost).
+    float wordSkipCost(const PhonemeSchedule& phonemes) const {
+        int sounded = 0;
+        for (const auto& seg : phonemes)
+            if (const auto idx = set_.find(seg.phoneme); idx && *idx != set_.silence()) ++sounded;
+        return std::max(config_.skipWordCost,
+                        config_.skipPhonemeCost * static_cast<float>(sounded));
+    }
+
+    std::vector<float> wordSkipCost_;  // per word, in script order
     const PhonemeSet& set_;
     double hop_, scale_;
     AlignerConfig config_;

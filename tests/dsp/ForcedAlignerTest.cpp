@@ -208,6 +208,37 @@ TEST(ForcedAligner, AWordTheSpeakerSkippedIsNotPlaced) {
     expectBoundariesAt(a.schedule, f.boundaries);
 }
 
+const std::vector<Run> kLong = {{"bmp", 6}, {"ah", 8}, {"kg", 6}, {"ah", 8}, {"l", 6},
+                                {"ih", 8},  {"f", 6},  {"ah", 8}, {"l", 6},  {"ah", 10}};
+
+// A long word the voice fits poorly is aligned and judged by its confidence, not taken for one
+// the speaker left out: leaving it out costs by its phonemes (AlignerConfig::skipPhonemeCost). At
+// one price a word, however long, it was skipped (festvox-ru's "Покалывало" at a line's start).
+TEST(ForcedAligner, ALongWordTheVoiceFitsPoorlyIsAlignedNotSkipped) {
+    Frames f;
+    f.add({{"sil", 20}});
+    addOffTemplate(f, kLong, 5.0f);
+    addOffTemplate(f, kSee, 1.2f);
+    addOffTemplate(f, kWow, 1.2f);
+    f.add({{"sil", 20}});
+    const std::vector<ScriptWord> script = {word("pokalyvalo", kLong), word("see", kSee),
+                                            word("wow", kWow)};
+    const auto firstWord = [&](const AlignerConfig& c) {
+        ForcedAligner a(script, PhonemeSet::common(), kHop, 1.0, c);
+        return f.align(script, &a).words[0];
+    };
+    const auto said = firstWord({});
+    EXPECT_GT(said.confidence, 0.0f);
+    EXPECT_GE(said.start, 0.2 - 1e-9);  // within its own stretch, 0.2 .. 0.92 s
+    EXPECT_LE(said.end, 0.92 + 1e-9);
+    EXPECT_GT(said.end - said.start, 0.3);
+    AlignerConfig perWord;
+    perWord.skipPhonemeCost = 0;
+    const auto skipped = firstWord(perWord);
+    EXPECT_EQ(skipped.confidence, 0.0f);
+    EXPECT_EQ(skipped.end, skipped.start);
+}
+
 // A one-word line's word is never skipped, however poorly the voice fits it: it is aligned, and
 // its confidence says whether it was said. (Skipped, the line was all filler and its word had no
 // confidence at all: a child's "spectacles" in ktuberling.) In a longer line a word still may be.
