@@ -161,6 +161,11 @@ struct Evaluator {
         unusedWords.add(std::cerr, item.speaker, where(item), why, voiceHint(item.speaker));
     }
 
+    // A file scored from the audio alone, its words unusable (`e` says why).
+    void wordsLeftToAudio(const CorpusItem& item, const InputError& e) const {
+        wordsNotUsed(item, std::string("words not used: ") + e.what() + "; audio-only analysis");
+    }
+
     // The schedule under test and the levels the runtime opens the jaw by: aligned on the
     // words beside the file (--align), else analysed from the audio alone.
     std::pair<PhonemeSchedule, LevelTrack> schedule(const CorpusItem& item) const {
@@ -203,8 +208,7 @@ struct Evaluator {
             for (const auto& w : r.warnings) std::cerr << where(item) << w << '\n';
             return r;
         } catch (const InputError& e) {
-            wordsNotUsed(item,
-                         std::string("words not used: ") + e.what() + "; audio-only analysis");
+            wordsLeftToAudio(item, e);
             return std::nullopt;
         }
     }
@@ -239,8 +243,7 @@ struct Evaluator {
             if (speaker) align(item, speaker);
             return std::pair(std::move(a.schedule), std::move(a.levels));
         } catch (const InputError& e) {
-            wordsNotUsed(item,
-                         std::string("words not used: ") + e.what() + "; audio-only analysis");
+            wordsLeftToAudio(item, e);
             return std::nullopt;
         }
     }

@@ -125,10 +125,13 @@ class GraphBuilder {
         const std::size_t unit = units_.size();
         std::vector<int> lasts;
         int shortest = std::numeric_limits<int>::max();
+        int sounded = 0;  // phones of espeak-ng's own reading
         for (std::size_t k = 0; k <= word.alternatives.size(); ++k) {
             const auto& phonemes = k == 0 ? word.phonemes : word.alternatives[k - 1];
             int frames = 0;
+            const int phonesBefore = graph_.phones;
             const int last = addChain(word.text, phonemes, w, unit, k == 0, frames);
+            if (k == 0) sounded = graph_.phones - phonesBefore;
             if (last < 0) {
                 if (k == 0) throw InputError("word '" + word.text + "' has no phonemes to align");
                 continue;  // an alternative of silence only: nothing to add
@@ -137,7 +140,7 @@ class GraphBuilder {
             shortest = std::min(shortest, frames);
         }
         graph_.minimumFrames += shortest;
-        wordSkipCost_.push_back(wordSkipCost(word.phonemes));
+        wordSkipCost_.push_back(wordSkipCost(sounded));
         units_.push_back(lasts);
         graph_.wordExpectedSeconds.push_back(graph_.expectedSeconds - before);
     }
@@ -243,10 +246,8 @@ class GraphBuilder {
 
     // A long word left out is a long stretch of the speaker's sound given to the words around
     // it; a short one may be said so fast that it leaves no trace (AlignerConfig::skipPhonemeCost).
-    float wordSkipCost(const PhonemeSchedule& phonemes) const {
-        int sounded = 0;
-        for (const auto& seg : phonemes)
-            if (const auto idx = set_.find(seg.phoneme); idx && *idx != set_.silence()) ++sounded;
+    // `sounded`: the word's phonemes other than silence in espeak-ng's reading.
+    float wordSkipCost(int sounded) const {
         return std::max(config_.skipWordCost,
                         config_.skipPhonemeCost * static_cast<float>(sounded));
     }
