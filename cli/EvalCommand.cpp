@@ -702,13 +702,14 @@ void addEvalCommand(CLI::App& app) {
     cmd->add_option("--voice", o->voices,
                     "With --align: the espeak-ng voice reading the words, VOICE for every "
                     "speaker or SPEAKER=VOICE for one (repeatable; default en-us)");
-    cmd->add_option("--follow-lag", o->followLag,
-                    "With --align: follow each file as the service follows a live line said "
-                    "after its cue (`lipsync ctl line`), each frame's class decided this many "
-                    "seconds after it (a fixed-lag alignment at the speed the voice reads the "
-                    "words), instead of aligning the whole file")
-        ->check(CLI::Range(0.0, dsp::AlignerConfig{}.lookaheadSeconds))
-        ->needs(align);
+    auto* followLag =
+        cmd->add_option("--follow-lag", o->followLag,
+                        "With --align: follow each file as the service follows a live line said "
+                        "after its cue (`lipsync ctl line`), each frame's class decided this many "
+                        "seconds after it (a fixed-lag alignment at the speed the voice reads the "
+                        "words), instead of aligning the whole file")
+            ->check(CLI::Range(0.0, dsp::AlignerConfig{}.lookaheadSeconds))
+            ->needs(align);
     auto* live = cmd->add_flag(
         "--live", o->live,
         "Score the service's live path instead: each file fed to lipsyncd's live input "
@@ -733,6 +734,15 @@ void addEvalCommand(CLI::App& app) {
                     "networks stay)",
                     0, 100)
         ->excludes(live);
+    addNumberOption(*cmd, "--follow-silence-cost", o->aligner.config.followingSilenceInSpeechCost,
+                    "With --follow-lag: cost per frame of silence where the energy gate hears "
+                    "speech, when following (a partial path owes no words yet, so a pause must "
+                    "cost about what a poorly fitting phoneme does)",
+                    0.0, 100.0)
+        ->needs(followLag)
+        ->excludes(live);
+    // The whole-file aligner's cost would be silently replaced by the one above.
+    cmd->get_option("--silence-in-speech-cost")->excludes(followLag);
     // The live path aligns as lipsyncd does: an aligner option there would be silently lost.
     for (auto* option : o->aligner.added) option->excludes(live);
     o->frontEnd.addTo(*cmd);

@@ -23,6 +23,7 @@ AlignerConfig following(AlignerConfig config, double lagSeconds) {
         throw InputError("the lag of a followed line must lie in 0.." +
                          std::to_string(config.lookaheadSeconds) + " s (the aligner's lookahead)");
     config.commitSeconds = LineFollower::kCommitSeconds;
+    config.silenceInSpeechCost = config.followingSilenceInSpeechCost;
     return config;
 }
 }  // namespace

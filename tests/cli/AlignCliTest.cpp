@@ -99,6 +99,16 @@ TEST(AlignCli, EvalFollowLagScoresLinesAsTheServiceFollowsThem) {
     const auto alone = runLipsync({"eval", "--corpus", dir.string(), "--follow-lag", "0.1"});
     EXPECT_EQ(alone.exitCode, 2);
     EXPECT_NE(alone.err.find("--follow-lag requires --align"), std::string::npos) << alone.err;
+    // Following prices a pause its own way (--follow-silence-cost): the whole-file aligner's
+    // cost would be dropped without a word, so it is refused there.
+    const auto wholeFileCost = runLipsync({"eval", "--corpus", dir.string(), "--align",
+                                           "--follow-lag", "0.1", "--silence-in-speech-cost", "1"});
+    EXPECT_EQ(wholeFileCost.exitCode, 2);
+    EXPECT_NE(wholeFileCost.err.find("--silence-in-speech-cost"), std::string::npos)
+        << wholeFileCost.err;
+    const auto own = runLipsync({"eval", "--corpus", dir.string(), "--align", "--follow-lag", "0.1",
+                                 "--follow-silence-cost", "1", "--no-per-file"});
+    EXPECT_EQ(own.exitCode, 0) << own.err;
 }
 
 // `--live`: the files through lipsyncd's live path, scored as the runtime took them; cued with

@@ -120,6 +120,70 @@ TEST(LineFollower, AddedWordsAreNotForcedIntoTheLine) {
     EXPECT_GE(groups(some.schedule, s.labels), groups(audioOnly.schedule, s.labels));
 }
 
+// A line said from the first frame by a voice the templates fit less well than the silence
+// class: each phoneme 1.5 dB off its templates, silence only 0.5 dB off (a telephone prompt,
+// said from its first sample). Offline every word must be placed by the end; a frame decided a
+// lag behind the newest has no such end, and at the whole-file aligner's 0.25 a frame of silence
+// the best partial path stayed in the lead-in: the words were followed as silence.
+TEST(LineFollower, ALineSaidAtOnceIsFollowedNotTakenForTheLeadIn) {
+    const auto& set = PhonemeSet::common();
+    const double hop = 0.01;
+    struct Run {
+        std::string phoneme;
+        int frames;
+    };
+    const std::vector<std::vector<Run>> words = {
+        {{"z", 10}, {"ih", 8}, {"kg", 10}, {"w", 10}, {"d", 15}},
+        {{"bmp", 8}, {"aa", 14}, {"l", 9}, {"ah", 12}}};
+    std::vector<dsp::ScriptWord> script;
+    std::vector<int> truth;  // each frame's class
+    for (const auto& runs : words) {
+        dsp::ScriptWord w{"w" + std::to_string(script.size()), {}};
+        double t = 0;
+        for (const auto& r : runs) {
+            w.phonemes.push_back({t, t + r.frames * hop, r.phoneme, 1.0f});
+            t += r.frames * hop;
+            truth.insert(truth.end(), static_cast<std::size_t>(r.frames),
+                         static_cast<int>(*set.find(r.phoneme)));
+        }
+        script.push_back(w);
+    }
+    const auto sil = static_cast<int>(set.silence());
+    truth.insert(truth.end(), 30, sil);
+    const auto followed = [&](const dsp::AlignerConfig& config) {
+        dsp::LineFollower follower(script, set, hop, 0.1, config);
+        std::vector<int> out;
+        follower.onSegment([&](const PhonemeSegment& seg) {
+            const auto c = static_cast<int>(*set.find(seg.phoneme));
+            while (out.size() * hop + hop / 2 < seg.end) out.push_back(c);
+        });
+        for (std::size_t i = 0; i < truth.size(); ++i) {
+            std::vector<float> d(set.size(), 10.0f);
+            dsp::FrameLabel label;
+            label.time = (static_cast<double>(i) + 0.5) * hop;
+            label.silent = truth[i] == sil;
+            if (!label.silent) {
+                d[*set.find("th")] = 4.0f;  // the nearest: a class no word has
+                d[static_cast<std::size_t>(sil)] = 4.5f;
+                d[static_cast<std::size_t>(truth[i])] = 5.5f;
+            } else {
+                d[static_cast<std::size_t>(sil)] = 4.0f;
+            }
+            label.phoneme = label.silent ? sil : static_cast<int>(*set.find("th"));
+            follower.push(label, d, d);
+        }
+        follower.finish();
+        std::size_t speech = 0, right = 0;
+        for (std::size_t i = 0; i < truth.size() && i < out.size(); ++i)
+            if (truth[i] != sil) ++speech, right += out[i] == truth[i];
+        return static_cast<double>(right) / static_cast<double>(speech);
+    };
+    EXPECT_GE(followed({}), 0.8);
+    dsp::AlignerConfig asWholeFiles;
+    asWholeFiles.followingSilenceInSpeechCost = asWholeFiles.silenceInSpeechCost;
+    EXPECT_LT(followed(asWholeFiles), 0.5);
+}
+
 TEST(LineFollower, RejectsALagBeyondTheLookahead) {
     const std::vector<dsp::ScriptWord> none;
     EXPECT_THROW(dsp::LineFollower(none, PhonemeSet::common(), 0.01, 5.0), InputError);

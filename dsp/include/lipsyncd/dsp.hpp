@@ -890,6 +890,15 @@ struct AlignerConfig {
     // 88.7 / 88.1 / 87.4 / 86.9 %, jaw r 0.65 / 0.85 → 0.65 / 0.87 from 0.25 on) and the
     // espeak-ng training corpus (boundary p95 43.5 → 42.5 ms from 0.25 on).
     float silenceInSpeechCost = 0.25f;
+    // The same cost when a line is followed as it is said (LineFollower), where each frame is
+    // decided from the best partial path. Offline every word must be placed before the end, so
+    // a cheap pause is paid back there; a partial path has no such debt, and one still in the
+    // lead-in (or a pause) at 0.25 a frame beat the words on voices the templates fit less well
+    // than that: the telephone prompts, said from their first sample, were followed as silence
+    // for most of each word. The tune voices (`lipsync eval --align --follow-lag 0.1`, score as
+    // in docs/measurements.md): 0.25 / 0.5 / 1 / 2 / 4 gave 684.8 / 696.8 / 699.8 / 699.4 /
+    // 698.9 (asterisk-ru-f 50.6 -> 58.8 % visual groups at 1).
+    float followingSilenceInSpeechCost = 1.0f;
     // Minimum durations: the segmenter's, and a fraction of the expected duration. Tuned on the
     // espeak-ng training corpus (bench/align_accuracy): fraction 0.3/0.4/0.5 gave boundary
     // p95 48.5/48.5/46.5 ms; a minimum pause of 80 ms (not 1 frame) cut missed boundaries by a
