@@ -54,7 +54,8 @@ void set(dsp::AlignerConfig& c, const std::string& assignment) {
         {"minConsonantSeconds", &dsp::AlignerConfig::minConsonantSeconds},
         {"minFractionOfExpected", &dsp::AlignerConfig::minFractionOfExpected},
         {"tailFractionOfExpected", &dsp::AlignerConfig::tailFractionOfExpected},
-        {"minimumMaxTimeScale", &dsp::AlignerConfig::minimumMaxTimeScale}};
+        {"minimumMaxTimeScale", &dsp::AlignerConfig::minimumMaxTimeScale},
+        {"fastestRestRate", &dsp::AlignerConfig::fastestRestRate}};
     if (floats.count(name))
         c.*floats.at(name) = static_cast<float>(v);
     else if (doubles.count(name))

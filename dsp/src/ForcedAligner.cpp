@@ -67,8 +67,16 @@ struct ForcedAligner::State {
         const auto n = graph.nodes.size();
         delta.assign(n, kNever);
         next.assign(n, kNever);
+        owed.assign(n, kNever);
         arg.assign(n, -1);
         delta[0] = 0;  // the start node, before the first frame
+        // The frames a word still to say takes at the fastest rate allowed for the rest of the
+        // line: the shortest path's frames, stretched to that rate (never below the shortest).
+        if (graph.minimumFrames > 0 && graph.words > 0) {
+            const double expected = graph.expectedSeconds / hopSeconds;
+            restStretch = std::max(1.0, expected / c.fastestRestRate / graph.minimumFrames);
+            framesPerWord = restStretch * std::max(1.0, double(graph.minimumFrames) / graph.words);
+        }
     }
 
     // Per-frame data the window keeps: back-pointers for the active nodes, and the excess
@@ -86,6 +94,7 @@ struct ForcedAligner::State {
     void ancestors(std::int64_t frame, std::span<int> nodes, std::int64_t atFrame) const;
     void commit(std::int64_t keepFrames);
     int commitFrom() const;
+    float behindCost(int node, double framesLeft) const;
     void emitPath(std::int64_t lastFrame, int node);
     void dropFront(std::int64_t frames);
 
@@ -96,6 +105,7 @@ struct ForcedAligner::State {
     AlignmentPath path;
     AlignmentSweep sweep;
     std::vector<float> delta, next;  // per node: cost of the best path there, last frame and this
+    std::vector<float> owed;         // step(): next plus behindCost, where the length is known
     std::vector<std::int32_t> arg;   // per node: where its best path came from this frame
     std::vector<int> alive, traced;  // commit(): the active nodes, and where their paths were
     int lo = 0, hi = 0;              // active nodes after the last frame
@@ -106,8 +116,9 @@ struct ForcedAligner::State {
     std::int64_t totalFrames = -1;  // the input's length, when known (expectFrames)
     std::size_t peakRows = 0;
     bool finished = false;
-    bool keepPath = true;    // false: following (followOnly)
-    std::vector<int> nodes;  // emitPath(): the path's node per frame
+    bool keepPath = true;                       // false: following (followOnly)
+    std::vector<int> nodes;                     // emitPath(): the path's node per frame
+    double restStretch = 1, framesPerWord = 1;  // behindCost()
 };
 
 namespace {
@@ -160,16 +171,25 @@ void ForcedAligner::State::scoreFrame(std::span<const float> distances,
 void ForcedAligner::State::step() {
     const int from = lo, to = graph.reach[hi];
     sweep.relax(delta, lo, hi, from, to, next, arg);
-    const int bestNode = firstBest(next, from, to);
+    // The beam ranks the paths by what each owes for having fallen behind the words too, so a
+    // path on time stays beside one behind that scores best for now (behindCost).
+    std::span<const float> ranked = next;
+    if (totalFrames >= 0) {
+        const double left = std::max(0.0, double(totalFrames - frames - 1));
+        for (int n = from; n <= to; ++n)
+            owed[n] = next[n] < kNever ? next[n] + behindCost(n, left) : kNever;
+        ranked = owed;
+    }
+    const int bestNode = firstBest(ranked, from, to);
     // Pause and filler nodes loop at a finite cost, so some node is always reachable.
     if (bestNode < 0) throw std::logic_error("forced alignment: no node reachable");
     // Keep what lies within the beam, and at most maxActiveNodes around the best: a select per
     // node (a branch on the beam would be mispredicted often), then the kept range's ends.
     const int half = std::max(1, config.maxActiveNodes / 2);
     const int keepLo = std::max(from, bestNode - half), keepHi = std::min(to, bestNode + half);
-    const float bound = next[bestNode] + config.beam;
+    const float bound = ranked[bestNode] + config.beam;
     for (int n = from; n < keepLo; ++n) delta[n] = kNever;
-    for (int n = keepLo; n <= keepHi; ++n) delta[n] = next[n] <= bound ? next[n] : kNever;
+    for (int n = keepLo; n <= keepHi; ++n) delta[n] = ranked[n] <= bound ? next[n] : kNever;
     for (int n = keepHi + 1; n <= to; ++n) delta[n] = kNever;
     int newLo = from, newHi = to;  // the best node is kept: both scans stop
     while (!(delta[newLo] < kNever)) ++newLo;
@@ -230,22 +250,24 @@ void ForcedAligner::State::dropFront(std::int64_t count) {
     windowStart += count;
 }
 
-// The partial path to commit to: the best, counting against each the words it could no longer
-// say in the frames left, at the cost of skipping them, once the input's length is known. A
-// path that fell behind the words can score best for a while (the words it has not reached
-// yet cost nothing so far) and then find no way through the rest.
+// What a path in `node` owes for having fallen behind the words (AlignerConfig::
+// fastestRestRate): skipWordCost for each word still to say that would not fit in the frames
+// left at that rate. Nothing while the input's length is unknown (a followed line).
+float ForcedAligner::State::behindCost(int node, double framesLeft) const {
+    if (totalFrames < 0) return 0;
+    const double over = restStretch * graph.framesToEnd[node] - framesLeft - kFrameSlack;
+    return over > 0 ? config.skipWordCost * float(std::ceil(over / framesPerWord)) : 0.0f;
+}
+
+// The partial path to commit to: the best, counting against each what it owes for having
+// fallen behind the words.
 int ForcedAligner::State::commitFrom() const {
     const double left = totalFrames > frames ? double(totalFrames - frames) : 0.0;
-    const double framesPerWord = std::max(1.0, double(graph.minimumFrames) / graph.words);
     int best = lo;
     float bestScore = kNever;
     for (int n = lo; n <= hi; ++n) {
         if (!(delta[n] < kNever)) continue;
-        float score = delta[n];
-        if (totalFrames >= 0) {
-            const double over = graph.framesToEnd[n] - left - kFrameSlack;
-            if (over > 0) score += config.skipWordCost * float(std::ceil(over / framesPerWord));
-        }
+        const float score = delta[n] + behindCost(n, left);
         if (score < bestScore) {
             bestScore = score;
             best = n;
