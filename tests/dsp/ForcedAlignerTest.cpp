@@ -303,10 +303,8 @@ TEST(ForcedAligner, LongInputIsAlignedInABoundedWindow) {
 }
 
 // A slow speaker whose last words sound more like the vowel before them than like themselves
-// (a real voice against templates): before the end, holding that vowel scores best. Committed
-// to it, the path cannot fit the last words in the frames left, and skips them.
-TEST(ForcedAligner, KnowingTheInputsLengthCommitsToAPathThatCanStillSayEveryWord) {
-    const auto& set = PhonemeSet::common();
+// (a real voice against templates): before the end, holding that vowel scores best.
+Frames slowSpeakerHoldingAVowel() {
     Frames f;
     f.add({{"sil", 20}});
     f.add(kMama);
@@ -315,48 +313,43 @@ TEST(ForcedAligner, KnowingTheInputsLengthCommitsToAPathThatCanStillSayEveryWord
         for (const auto& r : runs) slowSeeWow.push_back({r.phoneme, 2 * r.frames});
     addOffTemplate(f, slowSeeWow, 0.5f, "ah");
     f.add({{"sil", 10}});
+    return f;
+}
+
+// Whether the aligner reaches the end through every word, its last two placed.
+bool placesTheLastWords(const Frames& f, const AlignerConfig& config, bool knowLength) {
     const auto script = mamaSeeWow();
+    ForcedAligner aligner(script, PhonemeSet::common(), kHop, 1.0, config);
+    if (knowLength) aligner.expectFrames(static_cast<std::int64_t>(f.distances.size()));
+    const auto a = f.align(script, &aligner);
+    return a.complete && a.words[1].end > a.words[1].start && a.words[2].end > a.words[2].start;
+}
+
+// Committed to the path holding the vowel, the aligner cannot fit the last words in the frames
+// left, and skips them.
+TEST(ForcedAligner, KnowingTheInputsLengthCommitsToAPathThatCanStillSayEveryWord) {
+    const auto f = slowSpeakerHoldingAVowel();
     AlignerConfig config;
     config.commitSeconds = 1.4;
     config.lookaheadSeconds = 0.1;
-    auto placed = [&](bool knowLength) {
-        ForcedAligner aligner(script, set, kHop, 1.0, config);
-        if (knowLength) aligner.expectFrames(static_cast<std::int64_t>(f.distances.size()));
-        const auto a = f.align(script, &aligner);
-        return a.complete && a.words[1].end > a.words[1].start && a.words[2].end > a.words[2].start;
-    };
-    EXPECT_TRUE(placed(true));
-    EXPECT_FALSE(placed(false));  // the case this guards against still arises without it
-    config.commitSeconds = 100;   // no commit before the end: the whole input's best path
-    EXPECT_TRUE(placed(false));
+    EXPECT_TRUE(placesTheLastWords(f, config, true));
+    // The case this guards against still arises without it.
+    EXPECT_FALSE(placesTheLastWords(f, config, false));
+    config.commitSeconds = 100;  // no commit before the end: the whole input's best path
+    EXPECT_TRUE(placesTheLastWords(f, config, false));
 }
 
-// The same slow speaker without a commit: in a narrow beam, the paths still saying the words on
-// time lie too far behind the one holding the vowel and are dropped; then nothing reaches the
-// end through the words. Knowing the input's length, the beam weighs what a path behind the
-// words owes (the words it could no longer say at the line's rate) and keeps them.
+// Without a commit, in a narrow beam, the paths still saying the words on time lie too far
+// behind the one holding the vowel and are dropped; then nothing reaches the end through the
+// words. Knowing the input's length, the beam weighs what a path behind the words owes (the
+// words it could no longer say at the line's rate) and keeps them.
 TEST(ForcedAligner, KnowingTheInputsLengthKeepsPathsOnTimeInTheBeam) {
-    const auto& set = PhonemeSet::common();
-    Frames f;
-    f.add({{"sil", 20}});
-    f.add(kMama);
-    std::vector<dsp::Run> slowSeeWow;
-    for (const auto& runs : {kSee, kWow})
-        for (const auto& r : runs) slowSeeWow.push_back({r.phoneme, 2 * r.frames});
-    addOffTemplate(f, slowSeeWow, 0.5f, "ah");
-    f.add({{"sil", 10}});
-    const auto script = mamaSeeWow();
+    const auto f = slowSpeakerHoldingAVowel();
     AlignerConfig config;
     config.commitSeconds = 100;
     config.beam = 6;  // the paths on time lie 12 to 16 behind the vowel's here
-    auto placed = [&](bool knowLength) {
-        ForcedAligner aligner(script, set, kHop, 1.0, config);
-        if (knowLength) aligner.expectFrames(static_cast<std::int64_t>(f.distances.size()));
-        const auto a = f.align(script, &aligner);
-        return a.complete && a.words[1].end > a.words[1].start && a.words[2].end > a.words[2].start;
-    };
-    EXPECT_TRUE(placed(true));
-    EXPECT_FALSE(placed(false));  // the case this guards against still arises without it
+    EXPECT_TRUE(placesTheLastWords(f, config, true));
+    EXPECT_FALSE(placesTheLastWords(f, config, false));
 }
 
 TEST(ForcedAligner, NoFramesMeansNoWordPlacedAndNoCrash) {
