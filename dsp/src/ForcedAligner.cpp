@@ -71,10 +71,12 @@ struct ForcedAligner::State {
         arg.assign(n, -1);
         delta[0] = 0;  // the start node, before the first frame
         // The frames a word still to say takes at the fastest rate allowed for the rest of the
-        // line: the shortest path's frames, stretched to that rate (never below the shortest).
+        // line: the shortest path's frames, stretched to that rate (never below the shortest;
+        // a rate of 0 or less: the shortest alone).
         if (graph.minimumFrames > 0 && graph.words > 0) {
             const double expected = graph.expectedSeconds / hopSeconds;
-            restStretch = std::max(1.0, expected / c.fastestRestRate / graph.minimumFrames);
+            if (c.fastestRestRate > 0)
+                restStretch = std::max(1.0, expected / c.fastestRestRate / graph.minimumFrames);
             framesPerWord = restStretch * std::max(1.0, double(graph.minimumFrames) / graph.words);
         }
     }
