@@ -3,6 +3,7 @@
 // peak memory for 8 and 60 minutes of input. A program, not a benchmark: it prints one report.
 //
 //   build/bench/frontend_profile [--corpus DIR] [--minutes 8] [--long-minutes 60]
+//                                [--templates SET]  (default: the shipped set)
 //
 // Input: the espeak-ng dev corpus (every WAV under DIR, default /work/data/corpus/dev, made by
 // scripts/make-corpus.sh; without it, espeak-ng speech made in-process) resampled to 16 kHz and
@@ -172,10 +173,18 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     const float classPriorScale = dsp::ClassifierConfig{}.classPriorScale;
     std::vector<int> networkClass;
     std::vector<float> likelihoods, scratch;
+    dsp::FeatureSlopes
+        slopes;  // a class network that hears slopes: its inputs, as the classifier's
+    std::vector<float> withSlopes;
     if (templates.classNetwork) {
         networkClass = templates.classNetwork->setIndices(set);
         likelihoods.resize(networkClass.size());
         scratch.resize(templates.classNetwork->hiddenUnits());
+        if (templates.classNetwork->slopeFrames > 0) {
+            const auto n = static_cast<std::size_t>(templates.analysis.featureCount());
+            slopes = dsp::FeatureSlopes(templates.classNetwork->slopeFrames, n);
+            withSlopes.resize(templates.classNetwork->inputsFor(n));
+        }
     }
     dsp::FrameClassifier classifier(distancesOnly, set);
     float jawSum = 0;  // kept, so the network's work is not optimised away
@@ -238,10 +247,14 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
         if (templates.classNetwork)
             clock.time(Classes, [&] {
                 for (std::size_t k = 0; k < count; ++k) {
+                    if (!withSlopes.empty()) slopes.push(features[k].spectrum, withSlopes);
                     if (!features[k].valid) continue;
-                    templates.classNetwork->addToDistances(features[k].spectrum, networkClass,
-                                                           classNetworkDb, classPriorScale,
-                                                           distances[k], likelihoods, scratch);
+                    const auto input = withSlopes.empty()
+                                           ? std::span<const float>(features[k].spectrum)
+                                           : std::span<const float>(withSlopes);
+                    templates.classNetwork->addToDistances(input, networkClass, classNetworkDb,
+                                                           classPriorScale, distances[k],
+                                                           likelihoods, scratch);
                 }
             });
         if (templates.jawNetwork)
@@ -267,16 +280,22 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
 int main(int argc, char** argv) {
     std::filesystem::path corpus = "/work/data/corpus/dev";
     double minutes = 8, longMinutes = 60;
+    std::string set;  // a template set's name or file; empty: the shipped one
+    const auto load = [&] {
+        return set.empty() ? dsp::TemplateSet::loadDefault() : dsp::TemplateSet::named(set);
+    };
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string arg = argv[i];
-        if (arg == "--corpus")
+        if (arg == "--templates")
+            set = argv[i + 1];
+        else if (arg == "--corpus")
             corpus = argv[i + 1];
         else if (arg == "--minutes")
             minutes = std::stod(argv[i + 1]);
         else if (arg == "--long-minutes")
             longMinutes = std::stod(argv[i + 1]);
         else if (arg == "--analyze") {  // child: analyse one file, report time and memory
-            const auto templates = dsp::TemplateSet::loadDefault();
+            const auto templates = load();
             const double before = peakRssMiB();
             const double t0 = bench::threadCpuSeconds();
             const auto result = dsp::analyzeFile(argv[i + 1], templates, PhonemeSet::common());
@@ -288,12 +307,12 @@ int main(int argc, char** argv) {
                 result.schedule.size(), peakRssMiB(), before);
             return 0;
         } else {
-            std::cerr
-                << "usage: frontend_profile [--corpus DIR] [--minutes M] [--long-minutes M]\n";
+            std::cerr << "usage: frontend_profile [--corpus DIR] [--minutes M] [--long-minutes M] "
+                         "[--templates SET]\n";
             return 2;
         }
     }
-    const auto templates = dsp::TemplateSet::loadDefault();
+    const auto templates = load();
     const auto speech = corpusAt16k(corpus);
     std::printf("input: %.1f s of speech from %s, looped\n", speech.size() / 16000.0,
                 corpus.c_str());
@@ -307,7 +326,9 @@ int main(int argc, char** argv) {
     for (const auto& f : files) {
         pid_t pid = 0;
         std::string self = "/proc/self/exe", flag = "--analyze", path = f.string();
-        char* args[] = {self.data(), flag.data(), path.data(), nullptr};
+        std::string setFlag = "--templates", setName = set.empty() ? "default" : set;
+        char* args[] = {self.data(), setFlag.data(), setName.data(),
+                        flag.data(), path.data(),    nullptr};
         if (posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, args, environ) != 0 ||
             waitpid(pid, &status, 0) != pid || status != 0) {
             std::cerr << "frontend_profile: the analysis of " << f << " failed\n";

@@ -165,6 +165,10 @@ void addTrainCommand(CLI::App& app) {
                     0, 256);
     addNumberOption(*cmd, "--class-epochs", o->training.classEpochs,
                     "Passes of the class network's training", 1, 100);
+    addNumberOption(*cmd, "--class-slopes", o->training.classSlopeFrames,
+                    "The class network also hears each feature's slope over the frame and this "
+                    "many frames before it (a live frame waits for none); 0: the frame alone",
+                    0, dsp::ClassNetwork::kMaxSlopeFrames);
     addNumberOption(*cmd, "--order", o->training.analysis.order, "LPC order", 2, dsp::kMaxOrder);
     addNumberOption(*cmd, "--bins", o->training.analysis.spectrumBins, "Spectrum points 0..rate/2",
                     4, 512);

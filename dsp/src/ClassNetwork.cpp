@@ -87,7 +87,12 @@ void ClassNetwork::addToDistances(std::span<const float> features, std::span<con
 }
 
 void ClassNetwork::validate(std::size_t features, const std::string& source) const {
-    network::validateHiddenLayer(hiddenLayer(*this), features, "class_network", source);
+    if (slopeFrames < 0 || slopeFrames > kMaxSlopeFrames)
+        throw InputError(source, 0,
+                         "class_network.slope_frames: must be 0 to " +
+                             std::to_string(kMaxSlopeFrames) + " (" + std::to_string(slopeFrames) +
+                             ")");
+    network::validateHiddenLayer(hiddenLayer(*this), inputsFor(features), "class_network", source);
     const std::size_t units = hiddenBias.size(), count = classes.size();
     if (count < 2) throw InputError(source, 0, "class_network.classes: at least 2 classes");
     network::requireSize(outputWeights.size(), units, "class_network.output_weights", source);
@@ -178,6 +183,7 @@ ClassNetwork fineTuneClassNetwork(const ClassNetwork& base, std::span<const floa
                                         base.hiddenUnits(), epochs, seed, {&start, rate}),
                          base.classes);
     net.logPrior = base.logPrior;
+    net.slopeFrames = base.slopeFrames;
     return net;
 }
 

@@ -27,6 +27,11 @@ FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet&
         networkClass_ = classNetwork_->setIndices(set);
         likelihoods_.assign(networkClass_.size(), 0.0f);
         hiddenUnits_.assign(classNetwork_->hiddenUnits(), 0.0f);
+        if (classNetwork_->slopeFrames > 0) {
+            const auto features = static_cast<std::size_t>(templates.analysis.featureCount());
+            slopes_ = FeatureSlopes(classNetwork_->slopeFrames, features);
+            networkInput_.assign(classNetwork_->inputsFor(features), 0.0f);
+        }
     }
     if (!templates.classBiasDb.empty()) {
         classBias_.assign(set.size(), 0.0f);
@@ -53,6 +58,7 @@ void FrameClassifier::reset() {
     peakDb_ = -120;
     floorInitialised_ = false;
     lastTime_ = 0;
+    slopes_.reset();
 }
 
 // Σ w_c·jaw_c / Σ w_c over the classes, w_c = exp(−(d_c − best) / spread): a soft decision,
@@ -75,7 +81,9 @@ float FrameClassifier::expectedJaw(float best) const {
 // The hybrid's scaled likelihoods (Bourlard & Morgan 1994) as distance. Classes the network does
 // not know keep their template distance.
 void FrameClassifier::addClassNetwork(const FrameFeatures& frame) {
-    classNetwork_->addToDistances(frame.spectrum, networkClass_, config_.classNetworkDb,
+    const auto input =
+        networkInput_.empty() ? std::span<const float>(frame.spectrum) : networkInput_;
+    classNetwork_->addToDistances(input, networkClass_, config_.classNetworkDb,
                                   config_.classPriorScale, distances_, likelihoods_, hiddenUnits_);
 }
 
@@ -89,6 +97,8 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
     label.time = frame.time;
     label.energyDb = frame.energyDb;
     label.voiced = frame.valid && frame.normalizedError < config_.voicingThreshold;
+    // Every frame, silent or not, moves the slopes on: as in training (TemplateTrainer).
+    if (!networkInput_.empty()) slopes_.push(frame.spectrum, networkInput_);
 
     // Noise floor: follows quiet frames down at once, creeps up slowly during sound.
     const double dt = floorInitialised_ ? std::max(0.0, frame.time - lastTime_) : 0.0;

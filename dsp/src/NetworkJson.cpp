@@ -68,6 +68,7 @@ ClassNetwork readClassNetwork(const json& j, const std::string& source) {
     n.outputWeights = member<std::vector<std::vector<float>>>(j, "output_weights", p, source);
     n.outputBias = member<std::vector<float>>(j, "output_bias", p, source);
     n.logPrior = member<std::vector<float>>(j, "log_prior", p, source);
+    if (j.contains("slope_frames")) n.slopeFrames = member<int>(j, "slope_frames", p, source);
     return n;
 }
 
@@ -78,6 +79,7 @@ json writeClassNetwork(const ClassNetwork& n) {
     j["output_weights"] = output;
     j["output_bias"] = precise(n.outputBias);
     j["log_prior"] = precise(n.logPrior);
+    if (n.slopeFrames > 0) j["slope_frames"] = n.slopeFrames;
     return j;
 }
 

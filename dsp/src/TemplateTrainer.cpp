@@ -133,8 +133,19 @@ void TemplateTrainer::addNetworkFrames(std::span<const FrameFeatures> frames,
             jawUsable_ = false;  // a set without jaw heights: no jaw network
     }
     const auto half = static_cast<std::size_t>(std::lround(0.02 / options_.analysis.hopSeconds));
+    // The slopes run over every frame in order, as the classifier's do (FrameClassifier).
+    const bool slopes = options_.classSlopeFrames > 0 && options_.classHiddenUnits > 0;
+    const auto features = static_cast<std::size_t>(options_.analysis.featureCount());
+    auto slope = slopes ? FeatureSlopes(options_.classSlopeFrames, features) : FeatureSlopes{};
+    std::vector<float> withSlopes(slopes ? 2 * features : 0);
     for (std::size_t i = 0; i < frames.size(); ++i) {
         const auto& f = frames[i];
+        if (slopes) {
+            if (f.spectrum.size() != features)
+                throw InputError("training: a frame of " + std::to_string(f.spectrum.size()) +
+                                 " features where the analysis makes " + std::to_string(features));
+            slope.push(f.spectrum, withSlopes);
+        }
         if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb || cls[i] < 0) continue;
         const std::size_t lo = i > half ? i - half : 0, hi = std::min(frames.size(), i + half + 1);
         float sum = 0;
@@ -142,6 +153,7 @@ void TemplateTrainer::addNetworkFrames(std::span<const FrameFeatures> frames,
         jawTargets_.push_back(sum / static_cast<float>(hi - lo));
         classTargets_.push_back(static_cast<std::uint16_t>(cls[i]));
         networkInputs_.insert(networkInputs_.end(), f.spectrum.begin(), f.spectrum.end());
+        classInputs_.insert(classInputs_.end(), withSlopes.begin(), withSlopes.end());
     }
 }
 
@@ -175,8 +187,12 @@ std::optional<ClassNetwork> TemplateTrainer::trainClasses(std::size_t bins) cons
     std::vector<std::uint16_t> labels;
     labels.reserve(classTargets_.size());
     for (auto c : classTargets_) labels.push_back(static_cast<std::uint16_t>(index[c]));
-    return trainClassNetwork(networkInputs_, labels, names, bins, options_.classHiddenUnits,
-                             options_.classEpochs, options_.seed);
+    const bool slopes = !classInputs_.empty();
+    auto net = trainClassNetwork(slopes ? classInputs_ : networkInputs_, labels, names,
+                                 slopes ? 2 * bins : bins, options_.classHiddenUnits,
+                                 options_.classEpochs, options_.seed);
+    if (slopes) net.slopeFrames = options_.classSlopeFrames;
+    return net;
 }
 
 TrainingOptions fineTuningOptions(const TemplateSet& set) {
@@ -184,6 +200,7 @@ TrainingOptions fineTuningOptions(const TemplateSet& set) {
     training.analysis = set.analysis;
     training.jawHiddenUnits = set.jawNetwork ? int(set.jawNetwork->hiddenUnits()) : 0;
     training.classHiddenUnits = set.classNetwork ? int(set.classNetwork->hiddenUnits()) : 0;
+    training.classSlopeFrames = set.classNetwork ? set.classNetwork->slopeFrames : 0;
     return training;
 }
 
@@ -195,6 +212,12 @@ TemplateSet TemplateTrainer::fineTuneNetworks(TemplateSet base, int epochs, floa
         base.jawNetwork = fineTuneJawNetwork(*base.jawNetwork, networkInputs_, jawTargets_, epochs,
                                              rate, options_.seed);
     if (!base.classNetwork) return base;
+    const bool slopes = base.classNetwork->slopeFrames > 0;
+    if (slopes != !classInputs_.empty() ||
+        (slopes && base.classNetwork->slopeFrames != options_.classSlopeFrames))
+        throw InputError("fine-tuning: frames made for a class network of other inputs");
+    const auto& source = slopes ? classInputs_ : networkInputs_;
+    const std::size_t width = base.classNetwork->inputsFor(features);
     // Per class of the set, its output in the network (-1: none).
     std::vector<int> outputOf(set_->size(), -1);
     const auto indices = base.classNetwork->setIndices(*set_);
@@ -206,8 +229,8 @@ TemplateSet TemplateTrainer::fineTuneNetworks(TemplateSet base, int epochs, floa
         const int output = outputOf[classTargets_[row]];
         if (output < 0) continue;
         labels.push_back(static_cast<std::uint16_t>(output));
-        const auto from = networkInputs_.begin() + static_cast<std::ptrdiff_t>(row * features);
-        inputs.insert(inputs.end(), from, from + static_cast<std::ptrdiff_t>(features));
+        const auto from = source.begin() + static_cast<std::ptrdiff_t>(row * width);
+        inputs.insert(inputs.end(), from, from + static_cast<std::ptrdiff_t>(width));
     }
     if (!labels.empty())
         base.classNetwork =

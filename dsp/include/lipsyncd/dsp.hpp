@@ -282,8 +282,16 @@ struct ClassNetwork {
     std::vector<std::vector<float>> outputWeights;  // per hidden unit: its weight to each class
     std::vector<float> outputBias;                  // per class
     std::vector<float> logPrior;                    // per class: ln of its share of the frames
+    // 0: the inputs are the frame's features. n > 0: the features, then each one's slope over
+    // the frame and the n before it (FeatureSlopes), twice the inputs.
+    int slopeFrames = 0;
+    static constexpr int kMaxSlopeFrames = 16;
 
     std::size_t hiddenUnits() const { return hiddenBias.size(); }
+    // The network's inputs for frames of `features` features.
+    std::size_t inputsFor(std::size_t features) const {
+        return slopeFrames > 0 ? 2 * features : features;
+    }
     // ln p(c | x) − priorScale · ln p(c) per class into `out` (classes.size() values), up to a
     // constant of the frame's (the softmax's normaliser, the same for every class); `scratch`:
     // at least hiddenUnits() values. No allocation. priorScale 1: the hybrid's scaled
@@ -301,6 +309,24 @@ struct ClassNetwork {
                         std::span<float> likelihoods, std::span<float> scratch) const;
     // InputError naming `source` and the field when sizes disagree or a value is not finite.
     void validate(std::size_t features, const std::string& source) const;
+};
+
+// Each feature's slope over the newest frame and the `frames` before it, by least squares: the
+// dynamic features of speech recognisers (Furui 1986), taken over past frames only, so that a
+// live frame waits for none. Frames before the first count as the first. What the class network
+// hears with ClassNetwork::slopeFrames, in training and in use alike.
+class FeatureSlopes {
+  public:
+    FeatureSlopes() = default;
+    FeatureSlopes(int frames, std::size_t features);
+    // The frame's features, then their slopes per frame, into `out` (2 · features values); the
+    // frame becomes the newest. No allocation.
+    void push(std::span<const float> frame, std::span<float> out);
+    void reset() { seen_ = 0; }
+
+  private:
+    std::size_t frames_ = 0, features_ = 0, seen_ = 0;
+    std::vector<float> past_;  // the last frames_ frames, [seen mod frames_][feature]
 };
 
 // Spectral templates: per class one or more log spectra (cluster means), on the grid of the
@@ -442,6 +468,8 @@ class FrameClassifier {
     void addClassBias();
     std::vector<float> classBias_;  // per class, dB (TemplateSet::classBiasDb); empty: none
     std::vector<float> likelihoods_, hiddenUnits_;  // the class network's, per frame
+    FeatureSlopes slopes_;                          // with ClassNetwork::slopeFrames
+    std::vector<float> networkInput_;               // the frame and its slopes, with slopes_
     std::vector<float> templateDistances_;
     int sil_ = 0;
     float noiseFloorDb_ = 0;
@@ -757,6 +785,9 @@ struct TrainingOptions {
     // 75.4 / 44.3 %; the templates alone 73.9 / 42.4 %.
     int classHiddenUnits = 32;
     int classEpochs = 4;
+    // The class network also hears each feature's slope over the frame and this many before it
+    // (ClassNetwork::slopeFrames; 0: the frame alone).
+    int classSlopeFrames = 0;
 };
 
 // Options for a TemplateTrainer that keeps the frames `set`'s own networks learn from (its
@@ -792,8 +823,9 @@ class TemplateTrainer {
     TrainingOptions options_;
     const PhonemeSet* set_;
     std::vector<std::vector<std::vector<float>>> spectra_;  // [class][frame][bin]
-    // The networks' frames: features each, and per frame the jaw height and the class index.
-    std::vector<float> networkInputs_, jawTargets_;
+    // The networks' frames: features each, and per frame the jaw height and the class index;
+    // with classSlopeFrames, the class network's inputs apart (the features and their slopes).
+    std::vector<float> networkInputs_, jawTargets_, classInputs_;
     std::vector<std::uint16_t> classTargets_;
     bool jawUsable_ = true;  // every labelled class has a jaw height
 };

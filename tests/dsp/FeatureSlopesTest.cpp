@@ -1,0 +1,142 @@
+// The class network hearing each feature's slope (ClassNetwork::slopeFrames, FeatureSlopes):
+// the slopes themselves, that training and the classifier take them alike (classes told apart
+// only by which way the spectrum moves), and their file form.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <lipsyncd/dsp.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "ExpectRejected.hpp"
+
+using namespace lipsyncd;
+using namespace lipsyncd::dsp;
+
+TEST(FeatureSlopes, ARampRisesByItsStepOnceItsFramesHaveCome) {
+    FeatureSlopes slopes(4, 3);
+    std::vector<float> out(6);
+    for (int t = 0; t < 10; ++t) {
+        const float x = static_cast<float>(t);
+        slopes.push(std::vector<float>{x, 2 * x + 5, -x}, out);
+        EXPECT_FLOAT_EQ(out[0], x);  // the frame itself first
+        EXPECT_FLOAT_EQ(out[1], 2 * x + 5);
+        if (t == 0) EXPECT_FLOAT_EQ(out[3], 0.0f);  // before the first frame: the first
+        if (t >= 4) {
+            EXPECT_NEAR(out[3], 1.0f, 1e-5);
+            EXPECT_NEAR(out[4], 2.0f, 1e-5);
+            EXPECT_NEAR(out[5], -1.0f, 1e-5);
+        }
+    }
+    slopes.reset();  // a new input: nothing of the old one's frames
+    slopes.push(std::vector<float>{100, 0, 0}, out);
+    EXPECT_FLOAT_EQ(out[3], 0.0f);
+    // Before the first frame the input holds it: a fall from it is a fall.
+    slopes.push(std::vector<float>{90, 0, 0}, out);
+    EXPECT_NEAR(out[3], -2.0f, 1e-5);  // positions 0..3 at 100, 4 at 90: (−200 + 180) / 10
+}
+
+namespace {
+// "aa" while bin 0 rises from −8 to 8 over 0.2 s, "ih" while it falls back: both classes hold the
+// same values, so neither a frame's spectrum nor the templates can tell them apart; which way
+// the spectrum moves can.
+struct Utterance {
+    std::vector<FrameFeatures> frames;
+    PhonemeSchedule labels;
+};
+
+Utterance risingAndFalling(std::mt19937& rng, int segments = 40) {
+    std::normal_distribution<float> noise(0, 1);
+    Utterance u;
+    double t = 0;
+    for (int segment = 0; segment < segments; ++segment) {
+        const bool aa = segment % 2 == 0;
+        u.labels.push_back({t, t + 0.2, aa ? "aa" : "ih", 1});
+        for (int i = 0; i < 20; ++i, t += 0.01) {
+            FrameFeatures f;
+            f.valid = true;
+            f.energyDb = -20;
+            f.time = t + 0.005;
+            const float ramp = -8.0f + 16.0f * static_cast<float>(i) / 19.0f;
+            f.spectrum = {(aa ? ramp : -ramp) + noise(rng), noise(rng), noise(rng), noise(rng)};
+            u.frames.push_back(std::move(f));
+        }
+    }
+    return u;
+}
+
+TemplateSet train(std::mt19937& rng, int slopeFrames) {
+    TrainingOptions options;
+    options.analysis = AnalysisConfig{};  // the spectrum alone, 4 bins
+    options.analysis.spectrumBins = 4;
+    options.clustersPerClass = 1;
+    options.jawHiddenUnits = 0;
+    options.classHiddenUnits = 8;
+    options.classEpochs = 20;
+    options.classSlopeFrames = slopeFrames;
+    TemplateTrainer trainer(options, PhonemeSet::common());
+    for (int i = 0; i < 4; ++i) {
+        const auto u = risingAndFalling(rng);
+        trainer.addUtterance(u.frames, u.labels);
+    }
+    return trainer.build("test");
+}
+
+double accuracy(const TemplateSet& t, std::mt19937& rng) {
+    const auto& set = PhonemeSet::common();
+    FrameClassifier classifier(t, set);
+    const auto u = risingAndFalling(rng);
+    int right = 0;
+    for (const auto& f : u.frames) {
+        const auto label = classifier.classify(f);
+        for (const auto& s : u.labels)
+            if (f.time >= s.start && f.time < s.end) right += set[label.phoneme].name == s.phoneme;
+    }
+    return static_cast<double>(right) / static_cast<double>(u.frames.size());
+}
+}  // namespace
+
+TEST(FeatureSlopes, TheClassNetworkHearsWhichWayTheSpectrumMoves) {
+    std::mt19937 rng(7);
+    const auto withSlopes = train(rng, 4), frameAlone = train(rng, 0);
+    ASSERT_TRUE(withSlopes.classNetwork && frameAlone.classNetwork);
+    EXPECT_EQ(withSlopes.classNetwork->slopeFrames, 4);
+    EXPECT_EQ(withSlopes.classNetwork->inputMean.size(), 8u);  // the frame and its slopes
+    EXPECT_EQ(frameAlone.classNetwork->inputMean.size(), 4u);
+    // Past frames only: the first frames after each turn still hear the slope before it.
+    EXPECT_GT(accuracy(withSlopes, rng), 0.85);
+    EXPECT_LT(accuracy(frameAlone, rng), 0.75);  // a coin, near enough
+}
+
+TEST(FeatureSlopes, TravelWithTheNetworkAndAreValidated) {
+    std::mt19937 rng(8);
+    const auto t = train(rng, 4);
+    const auto path = std::filesystem::temp_directory_path() / "lipsyncd_feature_slopes.json";
+    t.save(path);
+    const auto back = TemplateSet::load(path);
+    std::filesystem::remove(path);
+    ASSERT_TRUE(back.classNetwork.has_value());
+    EXPECT_EQ(back.classNetwork->slopeFrames, 4);
+    EXPECT_EQ(fineTuningOptions(back).classSlopeFrames, 4);
+
+    auto bad = t;
+    bad.classNetwork->slopeFrames = ClassNetwork::kMaxSlopeFrames + 1;
+    test::expectRejected(bad, "class_network.slope_frames: must be 0 to 16 (17)");
+    bad = t;
+    bad.classNetwork->slopeFrames = 0;  // its inputs are the slopes' too
+    test::expectRejected(bad, "class_network.input_mean has 8 values, expected 4");
+}
+
+TEST(FeatureSlopes, FineTuningKeepsTheSlopes) {
+    std::mt19937 rng(9);
+    const auto t = train(rng, 4);
+    TemplateTrainer trainer(fineTuningOptions(t), PhonemeSet::common());
+    const auto u = risingAndFalling(rng, 20);
+    trainer.addUtterance(u.frames, u.labels);
+    const auto tuned = trainer.fineTuneNetworks(t, 2, 1e-3f);
+    ASSERT_TRUE(tuned.classNetwork.has_value());
+    EXPECT_EQ(tuned.classNetwork->slopeFrames, 4);
+    EXPECT_EQ(tuned.classNetwork->inputMean.size(), 8u);
+    EXPECT_GT(accuracy(tuned, rng), 0.85);
+}
