@@ -4,16 +4,22 @@ docs/measurements.md's "Real people" tables on frame-classifier inputs (a develo
 
     bench/frame-classifier-inputs.py [--real build/real-speech] [--corpus build/corpus/train]
                                      [--lipsync build/cli/lipsync] [--cache build/frame-inputs]
+                                     [--seed 1] [--readers]
 
 Every recording of the espeak-ng training corpus and of the real speakers
 (config/corpus/real-speakers.txt, fetched by scripts/fetch-real-speech.sh) is analysed once with
 `lipsync analyze --features` (the 34 features the front end decides on) and, for comparison, as a
-24-band log mel filterbank to 5 kHz; the frames are cached per speaker in --cache. A network of
+24-band log mel filterbank to 5 kHz, and two cues of the waveform at the front end's 10 kHz (the
+voicing as the highest normalised autocorrelation at 2.5–14 ms, Boersma 1993, and zero crossings
+per ms); the frames are cached per speaker in --cache. A network of
 the shipped class network's shape (32 rectified units, softmax, Adam, 4 passes, 256 frames a
 batch) is trained on the espeak-ng corpus and the real training speakers other than the two that
 are scored left out (klettres-en-gb, asterisk-en-allison), and scored per frame in visual groups
 on those two and on the dev speakers. Choices are made on the left-out training speakers only.
-Prints one line per input variant, then the vocal-tract-length warp upper bound.
+Prints one line per input variant, then the vocal-tract-length warp upper bound. With --readers,
+also the 34 features' network trained with more and more of the readers our aligner labelled for
+the networks (train-templates.sh's build/real-speech/aligned/: the `networks` readers of
+real-speakers.txt first, then any others there): how the figures grow with real speech.
 """
 import argparse
 import glob
@@ -97,12 +103,48 @@ def mel_frames(wav):
     return (np.arange(n) * hop + win / 2) / rate, out.astype(np.float32)
 
 
+def resampled(wav, rate_out=10000):
+    """The file's mono samples at rate_out (band-limited by the FFT: dropped or zero bins)."""
+    with wave.open(str(wav)) as w:
+        rate, channels = w.getframerate(), w.getnchannels()
+        x = np.frombuffer(w.readframes(w.getnframes()), dtype=np.int16).astype(np.float64)
+    x = x.reshape(-1, channels).mean(1) / 32768
+    x -= x.mean()
+    n = max(1, round(len(x) * rate_out / rate))
+    spectrum = np.zeros(n // 2 + 1, complex)
+    kept = np.fft.rfft(x)[:len(spectrum)]
+    spectrum[:len(kept)] = kept
+    return np.fft.irfft(spectrum, n) * n / max(1, len(x))
+
+
+def waveform_cues(wav, times, rate=10000):
+    """Per frame time: the voicing (Boersma 1993: the windowed frame's autocorrelation over the
+    window's own, highest at lags 2.5–14 ms, over 40 ms) and zero crossings a ms (over 25 ms)."""
+    x = resampled(wav, rate)
+    win, half = round(rate * 0.04), round(rate * 0.02)
+    padded = np.concatenate([np.zeros(half), x, np.zeros(half + 1)])
+    at = np.clip(np.round(times * rate).astype(int), 0, len(x))
+    frames = padded[at[:, None] + np.arange(win)[None, :]]
+    frames -= frames.mean(1, keepdims=True)
+    hann = np.hanning(win)
+    nfft = 1 << int(np.ceil(np.log2(2 * win)))
+    lags = slice(round(rate * 0.0025), round(rate * 0.014))
+    ac = np.fft.irfft(np.abs(np.fft.rfft(frames * hann, nfft)) ** 2, nfft)
+    own = np.fft.irfft(np.abs(np.fft.rfft(hann, nfft)) ** 2, nfft)
+    voicing = (ac[:, lags] / (ac[:, :1] + 1e-12) / (own[lags] / own[0])).max(1)
+    centre = frames[:, half - round(rate * 0.0125):half + round(rate * 0.0125)]
+    crossings = (np.diff(np.signbit(centre).astype(np.int8), axis=1) != 0).sum(1) / 25.0
+    return np.stack([np.clip(voicing, -1, 1), crossings], 1).astype(np.float32)
+
+
 def speaker_frames(folder, lipsync, cache):
     """Cached per speaker: LPC features, mel features, classes, gate and file index per frame."""
     out = cache / f"{folder.parent.name}-{folder.name}.npz"
     if out.exists():
-        return dict(np.load(out))
-    parts = {k: [] for k in ("lpc", "lpc_y", "gate", "lpc_file", "mel", "mel_y", "mel_file")}
+        data = dict(np.load(out))
+        if "cues" in data:
+            return data
+    parts = {k: [] for k in ("lpc", "lpc_y", "gate", "lpc_file", "mel", "mel_y", "mel_file", "cues")}
     with tempfile.TemporaryDirectory() as tmp:
         for i, wav in enumerate(sorted(folder.glob("*.wav"))):
             lab = wav.with_suffix(".lab")
@@ -112,6 +154,7 @@ def speaker_frames(folder, lipsync, cache):
             t, x, gate = lpc_frames(lipsync, wav, Path(tmp))
             parts["lpc"].append(x), parts["gate"].append(gate)
             parts["lpc_y"].append(classes_at(t, segments)), parts["lpc_file"].append(np.full(len(t), i))
+            parts["cues"].append(waveform_cues(wav, t))
             t, x = mel_frames(wav)
             parts["mel"].append(x), parts["mel_y"].append(classes_at(t, segments))
             parts["mel_file"].append(np.full(len(t), i))
@@ -133,8 +176,22 @@ def slopes(x, files, reach=2):
     return num / (2 * sum(k * k for k in range(1, reach + 1)))
 
 
+def causal_slopes(x, files, frames=4):
+    """Each feature's least-squares slope over the frame and the `frames` before it, as
+    `lipsync train --class-slopes` gives the class network (frames before a file's first: its first)."""
+    first = np.zeros(len(files), dtype=int)
+    starts = np.r_[0, np.flatnonzero(np.diff(files)) + 1]
+    first[starts] = starts
+    first = np.maximum.accumulate(first)
+    weights = np.arange(frames + 1) - frames / 2
+    idx = np.arange(len(files))
+    return sum(w * x[np.maximum(idx - (frames - j), first)] for j, w in enumerate(weights)) / (weights ** 2).sum()
+
+
 def variant_inputs(d, variant):
     x, f = d["lpc"], d["lpc_file"]
+    if variant == "and their slopes over the last 5 frames":
+        return np.concatenate([x, causal_slopes(x, f)], axis=1)
     if variant == "and their slopes (±2 frames)":
         return np.concatenate([x, slopes(x, f)], axis=1)
     if variant == "and their slopes and curvature":
@@ -219,11 +276,15 @@ def main():
     ap.add_argument("--corpus", type=Path, default=HERE / "build/corpus/train")
     ap.add_argument("--lipsync", default=str(HERE / "build/cli/lipsync"))
     ap.add_argument("--cache", type=Path, default=HERE / "build/frame-inputs")
+    ap.add_argument("--seed", type=int, default=1, help="the networks' initial weights and batches")
+    ap.add_argument("--readers", action="store_true", help="also train with more and more readers")
     args = ap.parse_args()
     args.cache.mkdir(parents=True, exist_ok=True)
-    training, scored = [], []
+    training, scored, readers = [], [], []
     for line in (HERE / "config/corpus/real-speakers.txt").read_text().splitlines():
         fields = line.split("#", 1)[0].split()
+        if len(fields) == 3 and fields[1] == "networks":
+            readers.append(args.real / "aligned" / fields[0])
         if len(fields) == 3 and (args.real / fields[1] / fields[0]).is_dir():
             speaker, split = fields[0], fields[1]
             if split == "networks":  # words only: their labels are the aligner's (train-templates.sh)
@@ -237,9 +298,10 @@ def main():
     data = {f: speaker_frames(f, args.lipsync, args.cache) for f in training + scored}
     print("visual groups per frame: " + " / ".join(f.name for f in scored))
 
-    def row(label, inputs_of, speech_only=False, gate=True, kind="lpc"):
-        net = train(np.concatenate([inputs_of(data[f]) for f in training]),
-                    np.concatenate([data[f][f"{kind}_y"] for f in training]))
+    def row(label, inputs_of, speech_only=False, gate=True, kind="lpc", more=()):
+        net = train(np.concatenate([inputs_of(data[f]) for f in [*training, *more]]),
+                    np.concatenate([data[f][f"{kind}_y"] for f in [*training, *more]]),
+                    seed=args.seed)
         figures = [group_accuracy(net, inputs_of(data[f]), data[f][f"{kind}_y"],
                                   data[f]["gate"] if gate else None, speech_only) for f in scored]
         print(f"{label:45s}" + " / ".join(f"{a:.1f} %" for a in figures), flush=True)
@@ -247,8 +309,10 @@ def main():
 
     base = row("the 34 features", lambda d: d["lpc"])
     for variant in ["and their slopes (±2 frames)", "and their slopes and curvature",
+                    "and their slopes over the last 5 frames",
                     "five frames, ±20 ms", "five frames, ±40 ms", "three frames, the last 40 ms"]:
         row(variant, lambda d, v=variant: variant_inputs(d, v))
+    row("and the voicing and zero crossings", lambda d: np.concatenate([d["lpc"], d["cues"]], axis=1))
     print("speech frames only:")
     row("  the 34 LPC features", lambda d: d["lpc"], speech_only=True, gate=False)
     row("  24 log mel bands to 5 kHz and the level", lambda d: d["mel"], speech_only=True,
@@ -262,6 +326,18 @@ def main():
         best = max((group_accuracy(base, warp(d["lpc"], a), d["lpc_y"], d["gate"]), a)
                    for a in np.arange(0.84, 1.17, 0.04))
         print(f"  {f.name}: {best[0]:.1f} % at {best[1]:.2f}")
+    if args.readers:
+        others = sorted(p for p in (args.real / "aligned").glob("*") if p.is_dir() and p not in readers)
+        readers = [r for r in readers if r.is_dir()] + others
+        data.update({f: speaker_frames(f, args.lipsync, args.cache) for f in readers})
+        print("the 34 features, more readers in training (real frames: the readers' and the train speakers'):")
+        for k in sorted({0, min(2, len(readers)), len(readers) - len(others), len(readers)}):
+            frames = sum(len(data[f]["lpc"]) for f in [*training, *readers[:k]] if args.real in f.parents)
+            row(f"  {k} readers ({frames} frames)", lambda d: d["lpc"], more=readers[:k])
+            if k == len(readers) - len(others):  # the shipped networks' readers
+                row("  and their slopes over the last 5 frames",
+                    lambda d: variant_inputs(d, "and their slopes over the last 5 frames"),
+                    more=readers[:k])
 
 
 if __name__ == "__main__":
