@@ -595,6 +595,19 @@ TEST(LipsyncCli, TrainKeepTemplatesReplacesOnlyTheNetworksAskedFor) {
     ASSERT_TRUE(second.classNetwork && second.jawNetwork);
     EXPECT_EQ(second.classNetwork->hiddenUnits(), 8u);
     EXPECT_EQ(second.jawNetwork->hiddenUnits(), 8u);
+    // --class-slopes: the class network hears each feature's slope too, and the set analyses.
+    const auto sloped = dir.parent_path() / "with-slopes.json";
+    r = runLipsync({"train", dir.string(), "--keep-templates", out.string(), "--jaw-hidden", "0",
+                    "--class-hidden", "8", "--class-slopes", "2", "-o", sloped.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto third = dsp::TemplateSet::load(sloped);
+    ASSERT_TRUE(third.classNetwork.has_value());
+    EXPECT_EQ(third.classNetwork->slopeFrames, 2);
+    EXPECT_EQ(third.classNetwork->inputMean.size(),
+              2 * static_cast<std::size_t>(third.analysis.featureCount()));
+    r = runLipsync({"analyze", (dir / "s0-en-us.wav").string(), "--templates", sloped.string(),
+                    "-s", (dir.parent_path() / "sloped.tsv").string()});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
     r = runLipsync({"train", dir.string(), "--keep-templates", "default", "--jaw-hidden", "0",
                     "--class-hidden", "0", "-o", both.string()});
     EXPECT_EQ(r.exitCode, 1);
