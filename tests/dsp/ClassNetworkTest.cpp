@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "ExpectRejected.hpp"
+#include "LabelledFrames.hpp"
 
 using namespace lipsyncd;
 using namespace lipsyncd::dsp;
@@ -20,32 +21,18 @@ namespace {
 // Two classes, each heard two ways: "aa" with bins 0 and 1 both high or both low, "ih" with one
 // high and the other low. Each class's mean (one template a class) is the same flat spectrum,
 // so the templates cannot tell them apart; a network can (an exclusive or).
-struct Utterance {
-    std::vector<FrameFeatures> frames;
-    PhonemeSchedule labels;
-};
+using Utterance = test::LabelledFrames;
 
 // `shift` moves bins 0 and 1 apart by that much: another voice, whose frames of one class lie
 // where the first voice's lay for the other.
 Utterance utterance(std::mt19937& rng, int segments = 40, float shift = 0) {
     std::normal_distribution<float> noise(0, 1);
     std::bernoulli_distribution coin;
-    Utterance u;
-    double t = 0;
-    for (int segment = 0; segment < segments; ++segment) {
-        const bool aa = segment % 2 == 0;
-        u.labels.push_back({t, t + 0.2, aa ? "aa" : "ih", 1});
-        for (int i = 0; i < 20; ++i, t += 0.01) {
-            FrameFeatures f;
-            f.valid = true;
-            f.energyDb = -20;
-            f.time = t + 0.005;
-            const float a = coin(rng) ? 8.0f : -8.0f, b = aa ? a : -a;
-            f.spectrum = {a + shift + noise(rng), b - shift + noise(rng), noise(rng), noise(rng)};
-            u.frames.push_back(std::move(f));
-        }
-    }
-    return u;
+    return test::aaAndIhInTurn(segments, [&](bool aa, int) {
+        const float a = coin(rng) ? 8.0f : -8.0f, b = aa ? a : -a;
+        return std::vector<float>{a + shift + noise(rng), b - shift + noise(rng), noise(rng),
+                                  noise(rng)};
+    });
 }
 
 // The spectrum alone, 4 bins, one template a class; no networks until asked for.
@@ -75,16 +62,7 @@ TemplateSet train(std::mt19937& rng, int hiddenUnits = 8, int utterances = 4) {
 double accuracy(const TemplateSet& t, std::mt19937& rng, float classNetworkDb, float shift = 0) {
     ClassifierConfig config;
     config.classNetworkDb = classNetworkDb;
-    const auto& set = PhonemeSet::common();
-    FrameClassifier classifier(t, set, config);
-    const auto u = utterance(rng, 40, shift);
-    int right = 0;
-    for (const auto& f : u.frames) {
-        const auto label = classifier.classify(f);
-        for (const auto& s : u.labels)
-            if (f.time >= s.start && f.time < s.end) right += set[label.phoneme].name == s.phoneme;
-    }
-    return static_cast<double>(right) / static_cast<double>(u.frames.size());
+    return test::shareDecidedRight(t, utterance(rng, 40, shift), config);
 }
 }  // namespace
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ExpectRejected.hpp"
+#include "LabelledFrames.hpp"
 
 using namespace lipsyncd;
 using namespace lipsyncd::dsp;
@@ -41,29 +42,15 @@ namespace {
 // "aa" while bin 0 rises from −8 to 8 over 0.2 s, "ih" while it falls back: both classes hold the
 // same values, so neither a frame's spectrum nor the templates can tell them apart; which way
 // the spectrum moves can.
-struct Utterance {
-    std::vector<FrameFeatures> frames;
-    PhonemeSchedule labels;
-};
+using Utterance = test::LabelledFrames;
 
 Utterance risingAndFalling(std::mt19937& rng, int segments = 40) {
     std::normal_distribution<float> noise(0, 1);
-    Utterance u;
-    double t = 0;
-    for (int segment = 0; segment < segments; ++segment) {
-        const bool aa = segment % 2 == 0;
-        u.labels.push_back({t, t + 0.2, aa ? "aa" : "ih", 1});
-        for (int i = 0; i < 20; ++i, t += 0.01) {
-            FrameFeatures f;
-            f.valid = true;
-            f.energyDb = -20;
-            f.time = t + 0.005;
-            const float ramp = -8.0f + 16.0f * static_cast<float>(i) / 19.0f;
-            f.spectrum = {(aa ? ramp : -ramp) + noise(rng), noise(rng), noise(rng), noise(rng)};
-            u.frames.push_back(std::move(f));
-        }
-    }
-    return u;
+    return test::aaAndIhInTurn(segments, [&](bool aa, int i) {
+        const float ramp = -8.0f + 16.0f * static_cast<float>(i) / 19.0f;
+        return std::vector<float>{(aa ? ramp : -ramp) + noise(rng), noise(rng), noise(rng),
+                                  noise(rng)};
+    });
 }
 
 TemplateSet train(std::mt19937& rng, int slopeFrames) {
@@ -84,16 +71,7 @@ TemplateSet train(std::mt19937& rng, int slopeFrames) {
 }
 
 double accuracy(const TemplateSet& t, std::mt19937& rng) {
-    const auto& set = PhonemeSet::common();
-    FrameClassifier classifier(t, set);
-    const auto u = risingAndFalling(rng);
-    int right = 0;
-    for (const auto& f : u.frames) {
-        const auto label = classifier.classify(f);
-        for (const auto& s : u.labels)
-            if (f.time >= s.start && f.time < s.end) right += set[label.phoneme].name == s.phoneme;
-    }
-    return static_cast<double>(right) / static_cast<double>(u.frames.size());
+    return test::shareDecidedRight(t, risingAndFalling(rng));
 }
 }  // namespace
 
