@@ -326,6 +326,7 @@ class FeatureSlopes {
 
   private:
     std::size_t frames_ = 0, features_ = 0, seen_ = 0;
+    std::vector<float> weights_;  // per position 0..frames_: (j − frames_/2) / Σ (j − frames_/2)²
     std::vector<float> past_;  // the last frames_ frames, [seen mod frames_][feature]
 };
 
