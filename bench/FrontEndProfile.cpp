@@ -173,8 +173,8 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     const float classPriorScale = dsp::ClassifierConfig{}.classPriorScale;
     std::vector<int> networkClass;
     std::vector<float> likelihoods, scratch;
-    dsp::FeatureSlopes
-        slopes;  // a class network that hears slopes: its inputs, as the classifier's
+    // A class network that hears slopes: its inputs, made as the classifier makes them.
+    dsp::FeatureSlopes slopes;
     std::vector<float> withSlopes;
     if (templates.classNetwork) {
         networkClass = templates.classNetwork->setIndices(set);

@@ -85,12 +85,17 @@ def mel_bank(rate, nfft, bands=24, low=100.0, high=5000.0):
     return bank
 
 
-def mel_frames(wav):
-    """(times, 24 band levels in dB + the frame level relative to the file's loudest), 10 ms."""
+def mono(wav, dtype):
+    """(rate, the file's samples in [-1, 1), its channels averaged) of a 16-bit WAV."""
     with wave.open(str(wav)) as w:
         rate, channels = w.getframerate(), w.getnchannels()
-        x = np.frombuffer(w.readframes(w.getnframes()), dtype=np.int16).astype(np.float32)
-    x = x.reshape(-1, channels).mean(1) / 32768
+        x = np.frombuffer(w.readframes(w.getnframes()), dtype=np.int16).astype(dtype)
+    return rate, x.reshape(-1, channels).mean(1) / 32768
+
+
+def mel_frames(wav):
+    """(times, 24 band levels in dB + the frame level relative to the file's loudest), 10 ms."""
+    rate, x = mono(wav, np.float32)
     x = np.append(x[:1], x[1:] - 0.97 * x[:-1])
     hop, win = round(rate * 0.01), round(rate * 0.025)
     nfft = 1 << int(np.ceil(np.log2(win)))
@@ -105,10 +110,7 @@ def mel_frames(wav):
 
 def resampled(wav, rate_out=10000):
     """The file's mono samples at rate_out (band-limited by the FFT: dropped or zero bins)."""
-    with wave.open(str(wav)) as w:
-        rate, channels = w.getframerate(), w.getnchannels()
-        x = np.frombuffer(w.readframes(w.getnframes()), dtype=np.int16).astype(np.float64)
-    x = x.reshape(-1, channels).mean(1) / 32768
+    rate, x = mono(wav, np.float64)
     x -= x.mean()
     n = max(1, round(len(x) * rate_out / rate))
     spectrum = np.zeros(n // 2 + 1, complex)
