@@ -40,7 +40,7 @@
 set -euo pipefail
 usage() {
   echo "usage: scripts/train-templates.sh [--networks-only] [--channel-normalised]" \
-    "[--leave-out SPEAKER]... [-o OUT.json] [--no-fetch] [--seed N]" >&2
+    "[--leave-out SPEAKER]... [-o OUT.json] [--no-fetch] [--seed N] [--class-slopes N]" >&2
   exit 2
 }
 networks_only=0 normalised=0 out="" fetch=1 leave_out=() seed=() slopes=4
@@ -109,11 +109,12 @@ done
 # aligner is the labeller), on templates trained first from the labelled speech alone, so the
 # labels never depend on the set they go into: the same packages and build give the same file.
 # fotaq's actors (16 kbps MP3) listed as `train` go into the templates only, as `networks` (as
-# shipped) into the networks only. In the templates, on the real training speakers each left out of their own set (klettres-en-gb /
-# asterisk-en-allison, audio only) the templates with them gave 76.7 / 46.5 % visual groups
-# against 76.3 / 45.0 %, closures caught 100 / 96.9 % against 100 / 96.1 %; networks trained on
-# them too 77.3 / 46.8 %, but closures caught 100 / 94.4 %. (Not listed in the shipped set's
-# training yet: docs/measurements.md, "Real people".)
+# shipped since the thirty-second session) into the networks only. When first measured (at most
+# 40 clips a character), on the real training speakers each left out of their own set
+# (klettres-en-gb / asterisk-en-allison, audio only) the templates with them gave 76.7 / 46.5 %
+# visual groups against 76.3 / 45.0 %, closures caught 100 / 96.9 % against 100 / 96.1 %;
+# networks trained on them too 77.3 / 46.8 %, but closures caught 100 / 94.4 %
+# (docs/measurements.md, "Real people").
 template_folders=()
 if [ ${#by_aligner[@]} -gt 0 ]; then
   labeller="$real/labeller-templates.json"
@@ -158,8 +159,8 @@ if [ "$networks_only" = 0 ]; then
     -o "$out" --description "$kind: trained by scripts/train-templates.sh on $about ($detail)"
 fi
 # The networks also hear the `networks` speakers (tuxpaint's readers in nine languages and fotaq's
-# actors: two and a half hours of people), and the espeak-ng corpus four times. The jaw network has 32 hidden units, the class network 64,
-# 4 passes each. Chosen on the six tune voices (summed, audio only, before any class bias) and
+# actors: two and a half hours of people), and the espeak-ng corpus four times. The jaw network
+# has 32 hidden units, the class network 64, 4 passes each. Chosen on the six tune voices (summed, audio only, before any class bias) and
 # on the training speakers each left out of the networks (klettres-en-gb / asterisk-en-allison;
 # docs/measurements.md, "More people in the networks"):
 #   without the tuxpaint readers, 32 units, espeak-ng twice: tune 270.1 % visual groups, jaw r
@@ -174,7 +175,9 @@ fi
 # added: tune 293.1 % visual groups summed, score 696.55 (five readers, no fotaq: 285.7, 689.35),
 # and with the class network hearing the slopes over 5 frames (--class-slopes 4, this) against the
 # frame alone, the same speech: 293.1 / 288.4 % summed, score 696.55 / 690.30, live 637.75 /
-# 627.60; seeds 2 and 3 with slopes 695.65 and 691.05.
+# 627.60; seeds 2 and 3 with slopes 695.65 and 691.05. On that speech the jaw network with 64
+# units or 8 passes did no better (tune jaw r the same to the hundredth; score 699.05 / 698.35
+# against 707.55, the shipped class bias beside each).
 description="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["description"].split(" + jaw network")[0])' "$out")"
 class_about="class network (64 units)"
 [ "$slopes" = 0 ] || class_about="class network (64 units, hearing the slopes over $((slopes + 1)) frames)"
