@@ -137,7 +137,8 @@ void TemplateTrainer::addNetworkFrames(std::span<const FrameFeatures> frames,
     const bool slopes = options_.classSlopeFrames > 0 && options_.classHiddenUnits > 0;
     const auto features = static_cast<std::size_t>(options_.analysis.featureCount());
     auto slope = slopes ? FeatureSlopes(options_.classSlopeFrames, features) : FeatureSlopes{};
-    std::vector<float> withSlopes(slopes ? 2 * features : 0);
+    std::vector<float> withSlopes(
+        slopes ? ClassNetwork::inputsFor(features, options_.classSlopeFrames) : 0);
     for (std::size_t i = 0; i < frames.size(); ++i) {
         const auto& f = frames[i];
         if (slopes) {
@@ -187,11 +188,11 @@ std::optional<ClassNetwork> TemplateTrainer::trainClasses(std::size_t bins) cons
     std::vector<std::uint16_t> labels;
     labels.reserve(classTargets_.size());
     for (auto c : classTargets_) labels.push_back(static_cast<std::uint16_t>(index[c]));
-    const bool slopes = !classInputs_.empty();
-    auto net = trainClassNetwork(slopes ? classInputs_ : networkInputs_, labels, names,
-                                 slopes ? 2 * bins : bins, options_.classHiddenUnits,
-                                 options_.classEpochs, options_.seed);
-    if (slopes) net.slopeFrames = options_.classSlopeFrames;
+    const int slopeFrames = classInputs_.empty() ? 0 : options_.classSlopeFrames;
+    auto net = trainClassNetwork(slopeFrames > 0 ? classInputs_ : networkInputs_, labels, names,
+                                 ClassNetwork::inputsFor(bins, slopeFrames),
+                                 options_.classHiddenUnits, options_.classEpochs, options_.seed);
+    net.slopeFrames = slopeFrames;
     return net;
 }
 

@@ -288,10 +288,11 @@ struct ClassNetwork {
     static constexpr int kMaxSlopeFrames = 16;
 
     std::size_t hiddenUnits() const { return hiddenBias.size(); }
-    // The network's inputs for frames of `features` features.
-    std::size_t inputsFor(std::size_t features) const {
+    // A network's inputs for frames of `features` features, hearing `slopeFrames` as above.
+    static std::size_t inputsFor(std::size_t features, int slopeFrames) {
         return slopeFrames > 0 ? 2 * features : features;
     }
+    std::size_t inputsFor(std::size_t features) const { return inputsFor(features, slopeFrames); }
     // ln p(c | x) − priorScale · ln p(c) per class into `out` (classes.size() values), up to a
     // constant of the frame's (the softmax's normaliser, the same for every class); `scratch`:
     // at least hiddenUnits() values. No allocation. priorScale 1: the hybrid's scaled
