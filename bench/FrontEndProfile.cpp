@@ -173,19 +173,18 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
     const float classPriorScale = dsp::ClassifierConfig{}.classPriorScale;
     std::vector<int> networkClass;
     std::vector<float> likelihoods, scratch;
-    // A class network that hears slopes: its inputs, made as the classifier makes them.
-    dsp::FeatureSlopes slopes;
-    std::vector<float> withSlopes;
+    // What each network hears (the frame, or it and its slopes), made as the classifier makes
+    // it; each stage makes its own, though the classifier shares one when both hear alike.
+    const auto featureCount = static_cast<std::size_t>(templates.analysis.featureCount());
+    dsp::NetworkInput classInput, jawInput;
     if (templates.classNetwork) {
         networkClass = templates.classNetwork->setIndices(set);
         likelihoods.resize(networkClass.size());
         scratch.resize(templates.classNetwork->hiddenUnits());
-        if (templates.classNetwork->slopeFrames > 0) {
-            const auto n = static_cast<std::size_t>(templates.analysis.featureCount());
-            slopes = dsp::FeatureSlopes(templates.classNetwork->slopeFrames, n);
-            withSlopes.resize(templates.classNetwork->inputsFor(n));
-        }
+        classInput = dsp::NetworkInput(templates.classNetwork->slopeFrames, featureCount);
     }
+    if (templates.jawNetwork)
+        jawInput = dsp::NetworkInput(templates.jawNetwork->slopeFrames, featureCount);
     dsp::FrameClassifier classifier(distancesOnly, set);
     float jawSum = 0;  // kept, so the network's work is not optimised away
     std::vector<dsp::FrameLabel> labels(kBlock);
@@ -247,11 +246,8 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
         if (templates.classNetwork)
             clock.time(Classes, [&] {
                 for (std::size_t k = 0; k < count; ++k) {
-                    if (!withSlopes.empty()) slopes.push(features[k].spectrum, withSlopes);
+                    const auto input = classInput.push(features[k].spectrum);
                     if (!features[k].valid) continue;
-                    const auto input = withSlopes.empty()
-                                           ? std::span<const float>(features[k].spectrum)
-                                           : std::span<const float>(withSlopes);
                     templates.classNetwork->addToDistances(input, networkClass, classNetworkDb,
                                                            classPriorScale, distances[k],
                                                            likelihoods, scratch);
@@ -259,8 +255,10 @@ void profileStages(const std::filesystem::path& file, const dsp::TemplateSet& te
             });
         if (templates.jawNetwork)
             clock.time(Jaw, [&] {
-                for (std::size_t k = 0; k < count; ++k)
-                    if (!labels[k].silent) jawSum += (*templates.jawNetwork)(features[k].spectrum);
+                for (std::size_t k = 0; k < count; ++k) {
+                    const auto input = jawInput.push(features[k].spectrum);
+                    if (!labels[k].silent) jawSum += (*templates.jawNetwork)(input);
+                }
             });
         clock.time(Viterbi, [&] {
             decided.clear();

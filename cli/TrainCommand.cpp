@@ -159,6 +159,10 @@ void addTrainCommand(CLI::App& app) {
                     0, 256);
     addNumberOption(*cmd, "--jaw-epochs", o->training.jawEpochs,
                     "Passes of the jaw network's training", 1, 100);
+    addNumberOption(*cmd, "--jaw-slopes", o->training.jawSlopeFrames,
+                    "The jaw network also hears each feature's slope over the frame and this "
+                    "many frames before it (a live frame waits for none); 0: the frame alone",
+                    0, dsp::kMaxSlopeFrames);
     addNumberOption(*cmd, "--class-hidden", o->training.classHiddenUnits,
                     "Hidden units of the class network trained beside the templates (scaled "
                     "class likelihoods added to the template distances); 0: none",
@@ -168,7 +172,7 @@ void addTrainCommand(CLI::App& app) {
     addNumberOption(*cmd, "--class-slopes", o->training.classSlopeFrames,
                     "The class network also hears each feature's slope over the frame and this "
                     "many frames before it (a live frame waits for none); 0: the frame alone",
-                    0, dsp::ClassNetwork::kMaxSlopeFrames);
+                    0, dsp::kMaxSlopeFrames);
     addNumberOption(*cmd, "--order", o->training.analysis.order, "LPC order", 2, dsp::kMaxOrder);
     addNumberOption(*cmd, "--bins", o->training.analysis.spectrumBins, "Spectrum points 0..rate/2",
                     4, 512);

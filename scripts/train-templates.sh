@@ -28,6 +28,8 @@
 #   --class-slopes N      the class network also hears each feature's slope over the frame and
 #                         the N before it (`lipsync train --class-slopes`; default 4, as shipped;
 #                         0: the frame alone, as the channel-normalised set's networks were made)
+#   --jaw-slopes N        the jaw network too (`lipsync train --jaw-slopes`; default 0, as shipped:
+#                         over 3, 5 and 9 frames the tune voices' jaw r stayed the same)
 #
 # The networks (the jaw and the class heard from each frame: config/templates/README.md) are
 # trained on the same speech, with `lipsync train --keep-templates`, which leaves the templates
@@ -40,10 +42,11 @@
 set -euo pipefail
 usage() {
   echo "usage: scripts/train-templates.sh [--networks-only] [--channel-normalised]" \
-    "[--leave-out SPEAKER]... [-o OUT.json] [--no-fetch] [--seed N] [--class-slopes N]" >&2
+    "[--leave-out SPEAKER]... [-o OUT.json] [--no-fetch] [--seed N] [--class-slopes N]" \
+    "[--jaw-slopes N]" >&2
   exit 2
 }
-networks_only=0 normalised=0 out="" fetch=1 leave_out=() seed=() slopes=4
+networks_only=0 normalised=0 out="" fetch=1 leave_out=() seed=() slopes=4 jaw_slopes=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --networks-only) networks_only=1 ;;
@@ -53,6 +56,7 @@ while [ $# -gt 0 ]; do
     --no-fetch) fetch=0 ;;
     --seed) [ $# -ge 2 ] && [[ "$2" =~ ^[0-9]+$ ]] || usage; seed=(--seed "$2"); shift ;;
     --class-slopes) [ $# -ge 2 ] && [[ "$2" =~ ^[0-9]+$ ]] || usage; slopes="$2"; shift ;;
+    --jaw-slopes) [ $# -ge 2 ] && [[ "$2" =~ ^[0-9]+$ ]] || usage; jaw_slopes="$2"; shift ;;
     -h|--help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;;
     *) usage ;;
   esac
@@ -181,8 +185,11 @@ fi
 description="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["description"].split(" + jaw network")[0])' "$out")"
 class_about="class network (64 units)"
 [ "$slopes" = 0 ] || class_about="class network (64 units, hearing the slopes over $((slopes + 1)) frames)"
-networks_about="jaw network (32 units) and $class_about on the same speech, espeak-ng's four times"
+jaw_about="jaw network (32 units)"
+[ "$jaw_slopes" = 0 ] || jaw_about="jaw network (32 units, hearing the slopes over $((jaw_slopes + 1)) frames)"
+networks_about="$jaw_about and $class_about on the same speech, espeak-ng's four times"
 [ ${#network_speakers[@]} -eq 0 ] || networks_about="$networks_about, and on ${network_speakers[*]}"
 "$lipsync" train ${seed[@]+"${seed[@]}"} "$corpus" "$corpus" "${folders[@]}" "${network_folders[@]+"${network_folders[@]}"}" \
-  --keep-templates "$out" --jaw-hidden 32 --jaw-epochs 4 --class-hidden 64 --class-epochs 4 --class-slopes "$slopes" -o "$out" \
+  --keep-templates "$out" --jaw-hidden 32 --jaw-epochs 4 --class-hidden 64 --class-epochs 4 --class-slopes "$slopes" \
+  --jaw-slopes "$jaw_slopes" -o "$out" \
   --description "$description + $networks_about"

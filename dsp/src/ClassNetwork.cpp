@@ -13,7 +13,7 @@ namespace lipsyncd::dsp {
 
 namespace {
 network::HiddenLayerView hiddenLayer(const ClassNetwork& net) {
-    return {net.inputMean, net.inputScale, net.hiddenWeights, net.hiddenBias};
+    return {net.inputMean, net.inputScale, net.hiddenWeights, net.hiddenBias, net.slopeFrames};
 }
 
 // ln Σ exp(z): the softmax's normaliser, from the largest term so that nothing overflows.
@@ -87,12 +87,7 @@ void ClassNetwork::addToDistances(std::span<const float> features, std::span<con
 }
 
 void ClassNetwork::validate(std::size_t features, const std::string& source) const {
-    if (slopeFrames < 0 || slopeFrames > kMaxSlopeFrames)
-        throw InputError(source, 0,
-                         "class_network.slope_frames: must be 0 to " +
-                             std::to_string(kMaxSlopeFrames) + " (" + std::to_string(slopeFrames) +
-                             ")");
-    network::validateHiddenLayer(hiddenLayer(*this), inputsFor(features), "class_network", source);
+    network::validateHiddenLayer(hiddenLayer(*this), features, "class_network", source);
     const std::size_t units = hiddenBias.size(), count = classes.size();
     if (count < 2) throw InputError(source, 0, "class_network.classes: at least 2 classes");
     network::requireSize(outputWeights.size(), units, "class_network.output_weights", source);

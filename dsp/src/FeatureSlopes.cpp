@@ -36,4 +36,16 @@ void FeatureSlopes::push(std::span<const float> frame, std::span<float> out) {
     ++seen_;
 }
 
+NetworkInput::NetworkInput(int slopeFrames, std::size_t features) {
+    if (slopeFrames <= 0) return;
+    slopes_ = FeatureSlopes(slopeFrames, features);
+    input_.assign(networkInputs(features, slopeFrames), 0.0f);
+}
+
+std::span<const float> NetworkInput::push(std::span<const float> frame) {
+    if (input_.empty()) return frame;
+    slopes_.push(frame, input_);
+    return input_;
+}
+
 }  // namespace lipsyncd::dsp

@@ -22,16 +22,18 @@ constexpr float kInitialNoiseFloorDb = -70.0f;
 FrameClassifier::FrameClassifier(const TemplateSet& templates, const PhonemeSet& set,
                                  const ClassifierConfig& config)
     : set_(&set), config_(config), jawNetwork_(templates.jawNetwork) {
+    const auto features = static_cast<std::size_t>(templates.analysis.featureCount());
     if (templates.classNetwork && config.classNetworkDb > 0) {
         classNetwork_ = templates.classNetwork;
         networkClass_ = classNetwork_->setIndices(set);
         likelihoods_.assign(networkClass_.size(), 0.0f);
         hiddenUnits_.assign(classNetwork_->hiddenUnits(), 0.0f);
-        if (classNetwork_->slopeFrames > 0) {
-            const auto features = static_cast<std::size_t>(templates.analysis.featureCount());
-            slopes_ = FeatureSlopes(classNetwork_->slopeFrames, features);
-            networkInput_.assign(classNetwork_->inputsFor(features), 0.0f);
-        }
+        classInput_ = NetworkInput(classNetwork_->slopeFrames, features);
+    }
+    if (jawNetwork_) {
+        jawHearsClassInput_ =
+            classNetwork_ && classNetwork_->slopeFrames == jawNetwork_->slopeFrames;
+        if (!jawHearsClassInput_) jawInput_ = NetworkInput(jawNetwork_->slopeFrames, features);
     }
     if (!templates.classBiasDb.empty()) {
         classBias_.assign(set.size(), 0.0f);
@@ -58,7 +60,8 @@ void FrameClassifier::reset() {
     peakDb_ = -120;
     floorInitialised_ = false;
     lastTime_ = 0;
-    slopes_.reset();
+    classInput_.reset();
+    jawInput_.reset();
 }
 
 // Σ w_c·jaw_c / Σ w_c over the classes, w_c = exp(−(d_c − best) / spread): a soft decision,
@@ -80,9 +83,7 @@ float FrameClassifier::expectedJaw(float best) const {
 
 // The hybrid's scaled likelihoods (Bourlard & Morgan 1994) as distance. Classes the network does
 // not know keep their template distance.
-void FrameClassifier::addClassNetwork(const FrameFeatures& frame) {
-    const auto input =
-        networkInput_.empty() ? std::span<const float>(frame.spectrum) : networkInput_;
+void FrameClassifier::addClassNetwork(std::span<const float> input) {
     classNetwork_->addToDistances(input, networkClass_, config_.classNetworkDb,
                                   config_.classPriorScale, distances_, likelihoods_, hiddenUnits_);
 }
@@ -98,7 +99,8 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
     label.energyDb = frame.energyDb;
     label.voiced = frame.valid && frame.normalizedError < config_.voicingThreshold;
     // Every frame, silent or not, moves the slopes on: as in training (TemplateTrainer).
-    if (!networkInput_.empty()) slopes_.push(frame.spectrum, networkInput_);
+    const auto classInput = classInput_.push(frame.spectrum);
+    const auto jawInput = jawHearsClassInput_ ? classInput : jawInput_.push(frame.spectrum);
 
     // Noise floor: follows quiet frames down at once, creeps up slowly during sound.
     const double dt = floorInitialised_ ? std::max(0.0, frame.time - lastTime_) : 0.0;
@@ -145,7 +147,7 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
 
     if (!templateDistances_.empty())  // before the terms below: what the aligner weighs
         std::copy(distances_.begin(), distances_.end(), templateDistances_.begin());
-    if (classNetwork_) addClassNetwork(frame);
+    if (classNetwork_) addClassNetwork(classInput);
     if (!classBias_.empty()) addClassBias();
 
     const int sil = sil_;
@@ -172,7 +174,7 @@ FrameLabel FrameClassifier::classify(const FrameFeatures& frame) {
 
     label.silent = !frame.valid || frame.energyDb < gate;
     if (!label.silent) {
-        label.jaw = jawNetwork_ ? (*jawNetwork_)(frame.spectrum) : expectedJaw(label.distance);
+        label.jaw = jawNetwork_ ? (*jawNetwork_)(jawInput) : expectedJaw(label.distance);
         return label;
     }
     label.runnerUp = label.phoneme;

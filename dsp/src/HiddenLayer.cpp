@@ -143,8 +143,13 @@ void requireSize(std::size_t size, std::size_t expected, const std::string& fiel
                              std::to_string(expected));
 }
 
-void validateHiddenLayer(const HiddenLayerView& layer, std::size_t features,
+void validateHiddenLayer(const HiddenLayerView& layer, std::size_t frameFeatures,
                          const std::string& prefix, const std::string& source) {
+    if (layer.slopeFrames < 0 || layer.slopeFrames > kMaxSlopeFrames)
+        throw InputError(source, 0,
+                         prefix + ".slope_frames: must be 0 to " + std::to_string(kMaxSlopeFrames) +
+                             " (" + std::to_string(layer.slopeFrames) + ")");
+    const std::size_t features = networkInputs(frameFeatures, layer.slopeFrames);
     if (features > kMaxFeatures)
         throw InputError(source, 0,
                          prefix + ": " + std::to_string(features) + " features, at most " +

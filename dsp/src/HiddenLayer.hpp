@@ -30,13 +30,15 @@ struct HiddenLayerView {
     std::span<const float> inputMean, inputScale;
     std::span<const std::vector<float>> weights;  // per feature: its weight to each unit
     std::span<const float> bias;                  // per unit
+    int slopeFrames = 0;                          // the network's: its inputs (networkInputs)
 };
 
 // The hidden units' sums (before rectifying) into a[0 .. units).
 void hiddenSums(const HiddenLayerView& layer, std::span<const float> features, float* a);
 
-// InputError naming `source` and the field (prefix + name) when the layer's sizes disagree
-// with `features` or a value is not finite.
+// InputError naming `source` and the field (prefix + name) when the layer's slopes are out of
+// range, its sizes disagree with the inputs frames of `features` features give, or a value is
+// not finite.
 void validateHiddenLayer(const HiddenLayerView& layer, std::size_t features,
                          const std::string& prefix, const std::string& source);
 void requireSize(std::size_t size, std::size_t expected, const std::string& field,

@@ -15,13 +15,13 @@ float logistic(float z) {
 }
 
 network::HiddenLayerView hiddenLayer(const JawNetwork& net) {
-    return {net.inputMean, net.inputScale, net.hiddenWeights, net.hiddenBias};
+    return {net.inputMean, net.inputScale, net.hiddenWeights, net.hiddenBias, net.slopeFrames};
 }
 }  // namespace
 
-float JawNetwork::operator()(std::span<const float> features) const {
+float JawNetwork::operator()(std::span<const float> inputs) const {
     std::array<float, network::kMaxHiddenUnits> a;
-    network::hiddenSums(hiddenLayer(*this), features, a.data());
+    network::hiddenSums(hiddenLayer(*this), inputs, a.data());
     const std::size_t units = hiddenBias.size();
     float z = outputBias;
     for (std::size_t h = 0; h < units; ++h) z += outputWeights[h] * network::rectify(a[h]);
@@ -75,8 +75,10 @@ JawNetwork fineTuneJawNetwork(const JawNetwork& base, std::span<const float> inp
                               std::uint32_t seed) {
     const network::TrainedLayers start{base.inputMean,  base.inputScale,      base.hiddenWeights,
                                        base.hiddenBias, {base.outputWeights}, {base.outputBias}};
-    return trainOnHeights(inputs, targets, base.inputMean.size(), base.hiddenUnits(), epochs, seed,
-                          {&start, rate});
+    auto net = trainOnHeights(inputs, targets, base.inputMean.size(), base.hiddenUnits(), epochs,
+                              seed, {&start, rate});
+    net.slopeFrames = base.slopeFrames;
+    return net;
 }
 
 }  // namespace lipsyncd::dsp

@@ -30,16 +30,19 @@ void readHiddenLayer(const json& j, const std::string& p, const std::string& sou
     n.inputScale = member<std::vector<float>>(j, "input_scale", p, source);
     n.hiddenWeights = member<std::vector<std::vector<float>>>(j, "hidden_weights", p, source);
     n.hiddenBias = member<std::vector<float>>(j, "hidden_bias", p, source);
+    if (j.contains("slope_frames")) n.slopeFrames = member<int>(j, "slope_frames", p, source);
 }
 
 template <class Network>
 json writeHiddenLayer(const Network& n) {
     json hidden = json::array();
     for (const auto& row : n.hiddenWeights) hidden.push_back(precise(row));
-    return {{"input_mean", precise(n.inputMean)},
-            {"input_scale", precise(n.inputScale)},
-            {"hidden_weights", hidden},
-            {"hidden_bias", precise(n.hiddenBias)}};
+    json j = {{"input_mean", precise(n.inputMean)},
+              {"input_scale", precise(n.inputScale)},
+              {"hidden_weights", hidden},
+              {"hidden_bias", precise(n.hiddenBias)}};
+    if (n.slopeFrames > 0) j["slope_frames"] = n.slopeFrames;
+    return j;
 }
 
 }  // namespace
@@ -68,7 +71,6 @@ ClassNetwork readClassNetwork(const json& j, const std::string& source) {
     n.outputWeights = member<std::vector<std::vector<float>>>(j, "output_weights", p, source);
     n.outputBias = member<std::vector<float>>(j, "output_bias", p, source);
     n.logPrior = member<std::vector<float>>(j, "log_prior", p, source);
-    if (j.contains("slope_frames")) n.slopeFrames = member<int>(j, "slope_frames", p, source);
     return n;
 }
 
@@ -79,7 +81,6 @@ json writeClassNetwork(const ClassNetwork& n) {
     j["output_weights"] = output;
     j["output_bias"] = precise(n.outputBias);
     j["log_prior"] = precise(n.logPrior);
-    if (n.slopeFrames > 0) j["slope_frames"] = n.slopeFrames;
     return j;
 }
 

@@ -50,7 +50,8 @@ std::pair<std::optional<ClassNetwork>, std::optional<JawNetwork>> readNetworks(
         classNetwork = readClassNetwork(j["class_network"], source);
         classNetwork->validate(features, source);
         if (!base.classNetwork || base.classNetwork->classes != classNetwork->classes ||
-            base.classNetwork->hiddenUnits() != classNetwork->hiddenUnits())
+            base.classNetwork->hiddenUnits() != classNetwork->hiddenUnits() ||
+            base.classNetwork->slopeFrames != classNetwork->slopeFrames)
             throw InputError(source, 0,
                              "field 'class_network': not the base set's class network trained "
                              "further; start again with `speaker reset`");
@@ -58,7 +59,8 @@ std::pair<std::optional<ClassNetwork>, std::optional<JawNetwork>> readNetworks(
     if (j.contains("jaw_network")) {
         jawNetwork = readJawNetwork(j["jaw_network"], source);
         jawNetwork->validate(features, source);
-        if (!base.jawNetwork || base.jawNetwork->hiddenUnits() != jawNetwork->hiddenUnits())
+        if (!base.jawNetwork || base.jawNetwork->hiddenUnits() != jawNetwork->hiddenUnits() ||
+            base.jawNetwork->slopeFrames != jawNetwork->slopeFrames)
             throw InputError(source, 0,
                              "field 'jaw_network': not the base set's jaw network trained "
                              "further; start again with `speaker reset`");

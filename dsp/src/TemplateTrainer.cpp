@@ -133,29 +133,37 @@ void TemplateTrainer::addNetworkFrames(std::span<const FrameFeatures> frames,
             jawUsable_ = false;  // a set without jaw heights: no jaw network
     }
     const auto half = static_cast<std::size_t>(std::lround(0.02 / options_.analysis.hopSeconds));
-    // The slopes run over every frame in order, as the classifier's do (FrameClassifier).
-    const bool slopes = options_.classSlopeFrames > 0 && options_.classHiddenUnits > 0;
+    // Each network's inputs run over every frame in order, as the classifier's do
+    // (FrameClassifier); a row is kept per frame the networks learn from.
     const auto features = static_cast<std::size_t>(options_.analysis.featureCount());
-    auto slope = slopes ? FeatureSlopes(options_.classSlopeFrames, features) : FeatureSlopes{};
-    std::vector<float> withSlopes(
-        slopes ? ClassNetwork::inputsFor(features, options_.classSlopeFrames) : 0);
+    std::map<int, NetworkInput> heard;
+    if (options_.jawHiddenUnits > 0) heard.try_emplace(options_.jawSlopeFrames);
+    if (options_.classHiddenUnits > 0) heard.try_emplace(options_.classSlopeFrames);
+    for (auto& [slopeFrames, input] : heard) input = NetworkInput(slopeFrames, features);
     for (std::size_t i = 0; i < frames.size(); ++i) {
         const auto& f = frames[i];
-        if (slopes) {
-            if (f.spectrum.size() != features)
-                throw InputError("training: a frame of " + std::to_string(f.spectrum.size()) +
-                                 " features where the analysis makes " + std::to_string(features));
-            slope.push(f.spectrum, withSlopes);
+        if (f.spectrum.size() != features)
+            throw InputError("training: a frame of " + std::to_string(f.spectrum.size()) +
+                             " features where the analysis makes " + std::to_string(features));
+        const bool learnt = f.valid && f.energyDb >= peak - options_.maxBelowPeakDb && cls[i] >= 0;
+        for (auto& [slopeFrames, input] : heard) {
+            const auto row = input.push(f.spectrum);
+            auto& rows = inputs_[slopeFrames];
+            if (learnt) rows.insert(rows.end(), row.begin(), row.end());
         }
-        if (!f.valid || f.energyDb < peak - options_.maxBelowPeakDb || cls[i] < 0) continue;
+        if (!learnt) continue;
         const std::size_t lo = i > half ? i - half : 0, hi = std::min(frames.size(), i + half + 1);
         float sum = 0;
         for (std::size_t k = lo; k < hi; ++k) sum += height[k];
         jawTargets_.push_back(sum / static_cast<float>(hi - lo));
         classTargets_.push_back(static_cast<std::uint16_t>(cls[i]));
-        networkInputs_.insert(networkInputs_.end(), f.spectrum.begin(), f.spectrum.end());
-        classInputs_.insert(classInputs_.end(), withSlopes.begin(), withSlopes.end());
     }
+}
+
+const std::vector<float>& TemplateTrainer::inputsWith(int slopeFrames) const {
+    static const std::vector<float> none;
+    const auto found = inputs_.find(slopeFrames);
+    return found == inputs_.end() ? none : found->second;
 }
 
 void TemplateTrainer::addSustained(std::span<const FrameFeatures> frames,
@@ -188,10 +196,10 @@ std::optional<ClassNetwork> TemplateTrainer::trainClasses(std::size_t bins) cons
     std::vector<std::uint16_t> labels;
     labels.reserve(classTargets_.size());
     for (auto c : classTargets_) labels.push_back(static_cast<std::uint16_t>(index[c]));
-    const int slopeFrames = classInputs_.empty() ? 0 : options_.classSlopeFrames;
-    auto net = trainClassNetwork(slopeFrames > 0 ? classInputs_ : networkInputs_, labels, names,
-                                 ClassNetwork::inputsFor(bins, slopeFrames),
-                                 options_.classHiddenUnits, options_.classEpochs, options_.seed);
+    const int slopeFrames = options_.classSlopeFrames;
+    auto net =
+        trainClassNetwork(inputsWith(slopeFrames), labels, names, networkInputs(bins, slopeFrames),
+                          options_.classHiddenUnits, options_.classEpochs, options_.seed);
     net.slopeFrames = slopeFrames;
     return net;
 }
@@ -201,23 +209,32 @@ TrainingOptions fineTuningOptions(const TemplateSet& set) {
     training.analysis = set.analysis;
     training.jawHiddenUnits = set.jawNetwork ? int(set.jawNetwork->hiddenUnits()) : 0;
     training.classHiddenUnits = set.classNetwork ? int(set.classNetwork->hiddenUnits()) : 0;
+    training.jawSlopeFrames = set.jawNetwork ? set.jawNetwork->slopeFrames : 0;
     training.classSlopeFrames = set.classNetwork ? set.classNetwork->slopeFrames : 0;
     return training;
 }
 
+// The frames kept for `net` (TrainingOptions as fineTuningOptions gives for the base): else the
+// trainer was made for other networks.
+template <class Network>
+const std::vector<float>& TemplateTrainer::tuningInputs(const Network& net,
+                                                        std::size_t features) const {
+    const auto& rows = inputsWith(net.slopeFrames);
+    if (classTargets_.empty() || rows.size() != classTargets_.size() * net.inputsFor(features))
+        throw InputError(
+            "fine-tuning: no frames of speech, or frames of another analysis or "
+            "made for networks of other inputs");
+    return rows;
+}
+
 TemplateSet TemplateTrainer::fineTuneNetworks(TemplateSet base, int epochs, float rate) const {
     const auto features = static_cast<std::size_t>(base.analysis.featureCount());
-    if (classTargets_.empty() || networkInputs_.size() != classTargets_.size() * features)
-        throw InputError("fine-tuning: no frames of speech, or frames of another analysis");
     if (base.jawNetwork && jawUsable_)
-        base.jawNetwork = fineTuneJawNetwork(*base.jawNetwork, networkInputs_, jawTargets_, epochs,
-                                             rate, options_.seed);
+        base.jawNetwork =
+            fineTuneJawNetwork(*base.jawNetwork, tuningInputs(*base.jawNetwork, features),
+                               jawTargets_, epochs, rate, options_.seed);
     if (!base.classNetwork) return base;
-    const bool slopes = base.classNetwork->slopeFrames > 0;
-    if (slopes != !classInputs_.empty() ||
-        (slopes && base.classNetwork->slopeFrames != options_.classSlopeFrames))
-        throw InputError("fine-tuning: frames made for a class network of other inputs");
-    const auto& source = slopes ? classInputs_ : networkInputs_;
+    const auto& source = tuningInputs(*base.classNetwork, features);
     const std::size_t width = base.classNetwork->inputsFor(features);
     // Per class of the set, its output in the network (-1: none).
     std::vector<int> outputOf(set_->size(), -1);
@@ -288,8 +305,10 @@ TemplateSet TemplateTrainer::build(const std::string& description) const {
     constexpr std::size_t kMinNetworkFrames = 2000;
     const bool enough = jawTargets_.size() >= kMinNetworkFrames;
     if (options_.jawHiddenUnits > 0 && jawUsable_ && enough)
-        t.jawNetwork = trainJawNetwork(networkInputs_, jawTargets_, bins, options_.jawHiddenUnits,
-                                       options_.jawEpochs, options_.seed);
+        t.jawNetwork = trainJawNetwork(inputsWith(options_.jawSlopeFrames), jawTargets_,
+                                       networkInputs(bins, options_.jawSlopeFrames),
+                                       options_.jawHiddenUnits, options_.jawEpochs, options_.seed);
+    if (t.jawNetwork) t.jawNetwork->slopeFrames = options_.jawSlopeFrames;
     if (options_.classHiddenUnits > 0 && enough) t.classNetwork = trainClasses(bins);
     if (options_.fullCovariance) {
         // Scaled so that a frame's expected distance to its own class's mean is what the

@@ -608,6 +608,18 @@ TEST(LipsyncCli, TrainKeepTemplatesReplacesOnlyTheNetworksAskedFor) {
     r = runLipsync({"analyze", (dir / "s0-en-us.wav").string(), "--templates", sloped.string(),
                     "-s", (dir.parent_path() / "sloped.tsv").string()});
     EXPECT_EQ(r.exitCode, 0) << r.err;
+    // --jaw-slopes: the jaw network's, apart from the class network's.
+    const auto jawSloped = dir.parent_path() / "with-jaw-slopes.json";
+    r = runLipsync({"train", dir.string(), "--keep-templates", sloped.string(), "--jaw-hidden", "8",
+                    "--jaw-slopes", "3", "--class-hidden", "0", "-o", jawSloped.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto fourth = dsp::TemplateSet::load(jawSloped);
+    ASSERT_TRUE(fourth.jawNetwork && fourth.classNetwork);
+    EXPECT_EQ(fourth.jawNetwork->slopeFrames, 3);
+    EXPECT_EQ(fourth.classNetwork->slopeFrames, 2);
+    r = runLipsync({"analyze", (dir / "s0-en-us.wav").string(), "--templates", jawSloped.string(),
+                    "-s", (dir.parent_path() / "jaw-sloped.tsv").string()});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
     r = runLipsync({"train", dir.string(), "--keep-templates", "default", "--jaw-hidden", "0",
                     "--class-hidden", "0", "-o", both.string()});
     EXPECT_EQ(r.exitCode, 1);

@@ -1,8 +1,11 @@
-// The class network hearing each feature's slope (ClassNetwork::slopeFrames, FeatureSlopes):
-// the slopes themselves, that training and the classifier take them alike (classes told apart
-// only by which way the spectrum moves), and their file form.
+// The networks hearing each feature's slope (ClassNetwork::slopeFrames, JawNetwork::slopeFrames,
+// FeatureSlopes): the slopes themselves, that training and the classifier take them alike
+// (classes, and their jaw heights, told apart only by which way the spectrum moves), and their
+// file form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <lipsyncd/dsp.hpp>
 #include <random>
@@ -23,7 +26,9 @@ TEST(FeatureSlopes, ARampRisesByItsStepOnceItsFramesHaveCome) {
         slopes.push(std::vector<float>{x, 2 * x + 5, -x}, out);
         EXPECT_FLOAT_EQ(out[0], x);  // the frame itself first
         EXPECT_FLOAT_EQ(out[1], 2 * x + 5);
-        if (t == 0) EXPECT_FLOAT_EQ(out[3], 0.0f);  // before the first frame: the first
+        if (t == 0) {
+            EXPECT_FLOAT_EQ(out[3], 0.0f);  // before the first frame: the first
+        }
         if (t >= 4) {
             EXPECT_NEAR(out[3], 1.0f, 1e-5);
             EXPECT_NEAR(out[4], 2.0f, 1e-5);
@@ -53,12 +58,14 @@ Utterance risingAndFalling(std::mt19937& rng, int segments = 40) {
     });
 }
 
-TemplateSet train(std::mt19937& rng, int slopeFrames) {
+TemplateSet train(std::mt19937& rng, int slopeFrames, int jawSlopeFrames = -1) {
     TrainingOptions options;
     options.analysis = AnalysisConfig{};  // the spectrum alone, 4 bins
     options.analysis.spectrumBins = 4;
     options.clustersPerClass = 1;
-    options.jawHiddenUnits = 0;
+    options.jawHiddenUnits = jawSlopeFrames < 0 ? 0 : 8;  // -1: no jaw network
+    options.jawEpochs = 60;
+    options.jawSlopeFrames = std::max(0, jawSlopeFrames);
     options.classHiddenUnits = 8;
     options.classEpochs = 20;
     options.classSlopeFrames = slopeFrames;
@@ -72,6 +79,30 @@ TemplateSet train(std::mt19937& rng, int slopeFrames) {
 
 double accuracy(const TemplateSet& t, std::mt19937& rng) {
     return test::shareDecidedRight(t, risingAndFalling(rng));
+}
+
+// How much further the jaw opens for aa than for ih.
+float aaAboveIh() {
+    const auto& set = PhonemeSet::common();
+    return *set[*set.find("aa")].jaw - *set[*set.find("ih")].jaw;
+}
+
+// The mean distance of the classifier's jaw from the labelled class's jaw height, over the
+// frames of the last 15 of each segment (the first few still hear the turn before them).
+double jawError(const TemplateSet& t, std::mt19937& rng) {
+    const auto& set = PhonemeSet::common();
+    FrameClassifier classifier(t, set);
+    const auto u = risingAndFalling(rng);
+    double sum = 0;
+    int counted = 0;
+    for (std::size_t i = 0; i < u.frames.size(); ++i) {
+        const float jaw = classifier.classify(u.frames[i]).jaw;
+        if (i % 20 < 5) continue;
+        const auto& label = u.labels[i / 20];
+        sum += std::abs(jaw - *set[*set.find(label.phoneme)].jaw);
+        ++counted;
+    }
+    return sum / counted;
 }
 }  // namespace
 
@@ -99,7 +130,7 @@ TEST(FeatureSlopes, TravelWithTheNetworkAndAreValidated) {
     EXPECT_EQ(fineTuningOptions(back).classSlopeFrames, 4);
 
     auto bad = t;
-    bad.classNetwork->slopeFrames = ClassNetwork::kMaxSlopeFrames + 1;
+    bad.classNetwork->slopeFrames = kMaxSlopeFrames + 1;
     test::expectRejected(bad, "class_network.slope_frames: must be 0 to 16 (17)");
     bad = t;
     bad.classNetwork->slopeFrames = 0;  // its inputs are the slopes' too
@@ -117,4 +148,74 @@ TEST(FeatureSlopes, FineTuningKeepsTheSlopes) {
     EXPECT_EQ(tuned.classNetwork->slopeFrames, 4);
     EXPECT_EQ(tuned.classNetwork->inputMean.size(), 8u);
     EXPECT_GT(accuracy(tuned, rng), 0.85);
+}
+
+TEST(FeatureSlopes, TheJawNetworkHearsThemToo) {
+    std::mt19937 rng(10);
+    const float apart = aaAboveIh();
+    ASSERT_GT(apart, 0.2f);
+    // Alone, as the class network hears them, and as the class network hears the frame alone.
+    for (const int classSlopes : {4, 0}) {
+        const auto withSlopes = train(rng, classSlopes, 4), frameAlone = train(rng, classSlopes, 0);
+        ASSERT_TRUE(withSlopes.jawNetwork && frameAlone.jawNetwork);
+        EXPECT_EQ(withSlopes.jawNetwork->slopeFrames, 4);
+        EXPECT_EQ(withSlopes.jawNetwork->inputMean.size(), 8u);
+        EXPECT_EQ(frameAlone.jawNetwork->inputMean.size(), 4u);
+        // The frame alone cannot tell aa's height from ih's: it settles between them.
+        EXPECT_LT(jawError(withSlopes, rng), 0.25 * apart) << classSlopes;
+        EXPECT_GT(jawError(frameAlone, rng), 0.4 * apart) << classSlopes;
+    }
+}
+
+TEST(FeatureSlopes, TheClassifiersJawIsTheNetworksOnWhatItHears) {
+    std::mt19937 rng(11);
+    for (const int classSlopes : {4, 2}) {  // one NetworkInput for both, and one each
+        const auto t = train(rng, classSlopes, 4);
+        FrameClassifier classifier(t, PhonemeSet::common());
+        NetworkInput heard(4, 4);
+        const auto u = risingAndFalling(rng, 4);
+        for (const auto& f : u.frames)
+            EXPECT_FLOAT_EQ(classifier.classify(f).jaw, (*t.jawNetwork)(heard.push(f.spectrum)));
+    }
+}
+
+TEST(FeatureSlopes, TheJawsTravelWithItAndAreValidated) {
+    std::mt19937 rng(12);
+    const auto t = train(rng, 0, 4);
+    const auto path = std::filesystem::temp_directory_path() / "lipsyncd_jaw_slopes.json";
+    t.save(path);
+    const auto back = TemplateSet::load(path);
+    std::filesystem::remove(path);
+    ASSERT_TRUE(back.jawNetwork.has_value());
+    EXPECT_EQ(back.jawNetwork->slopeFrames, 4);
+    EXPECT_EQ(back.classNetwork->slopeFrames, 0);
+    EXPECT_EQ(fineTuningOptions(back).jawSlopeFrames, 4);
+
+    auto bad = t;
+    bad.jawNetwork->slopeFrames = -1;
+    test::expectRejected(bad, "jaw_network.slope_frames: must be 0 to 16 (-1)");
+    bad = t;
+    bad.jawNetwork->slopeFrames = 0;
+    test::expectRejected(bad, "jaw_network.input_mean has 8 values, expected 4");
+}
+
+TEST(FeatureSlopes, FineTuningKeepsTheJawsSlopes) {
+    std::mt19937 rng(13);
+    const auto t = train(rng, 2, 4);
+    TemplateTrainer trainer(fineTuningOptions(t), PhonemeSet::common());
+    const auto u = risingAndFalling(rng, 20);
+    trainer.addUtterance(u.frames, u.labels);
+    const auto tuned = trainer.fineTuneNetworks(t, 2, 1e-3f);
+    ASSERT_TRUE(tuned.jawNetwork && tuned.classNetwork);
+    EXPECT_EQ(tuned.jawNetwork->slopeFrames, 4);
+    EXPECT_EQ(tuned.classNetwork->slopeFrames, 2);
+    EXPECT_NE(tuned.jawNetwork->outputWeights, t.jawNetwork->outputWeights);
+    EXPECT_LT(jawError(tuned, rng), 0.25 * aaAboveIh());
+
+    // A trainer keeping frames for other networks says so instead of training on the wrong rows.
+    auto options = fineTuningOptions(t);
+    options.jawSlopeFrames = 0;
+    TemplateTrainer other(options, PhonemeSet::common());
+    other.addUtterance(u.frames, u.labels);
+    EXPECT_THROW(other.fineTuneNetworks(t, 1, 1e-3f), InputError);
 }

@@ -204,6 +204,15 @@ TEST(SpeakerAdaptation, LearningNetworksTrainsThemFurtherOnEachLineAndKeepsThemI
     SpeakerAdaptation elsewhere(other);
     expectRefused(elsewhere, file, "class_network");  // networks trained from another set's
     EXPECT_EQ(elsewhere.frames(), 0u);
+    // A jaw network of the same shape that hears the slopes: not this file's either.
+    auto sloped = base;
+    auto& jaw = *sloped.jawNetwork;
+    jaw.slopeFrames = 2;
+    jaw.inputMean.resize(8, 0.0f);
+    jaw.inputScale.resize(8, 1.0f);
+    jaw.hiddenWeights.resize(8, {0.0f, 0.0f});
+    SpeakerAdaptation slopedVoice(sloped);
+    expectRefused(slopedVoice, file, "jaw_network");
     std::filesystem::remove(file);
 }
 

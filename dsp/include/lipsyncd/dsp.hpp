@@ -248,6 +248,48 @@ class FrameAnalyzer {
 // ---------------------------------------------------------------------------------------------
 // Templates and classification.
 
+// Each feature's slope over the newest frame and the `frames` before it, by least squares: the
+// dynamic features of speech recognisers (Furui 1986), taken over past frames only, so that a
+// live frame waits for none. Frames before the first count as the first. What a network hears
+// with its slopeFrames (JawNetwork, ClassNetwork), in training and in use alike.
+class FeatureSlopes {
+  public:
+    FeatureSlopes() = default;
+    FeatureSlopes(int frames, std::size_t features);
+    // The frame's features, then their slopes per frame, into `out` (2 · features values); the
+    // frame becomes the newest. No allocation.
+    void push(std::span<const float> frame, std::span<float> out);
+    void reset() { seen_ = 0; }
+
+  private:
+    std::size_t frames_ = 0, features_ = 0, seen_ = 0;
+    std::vector<float> weights_;  // per position 0..frames_: (j − frames_/2) / Σ (j − frames_/2)²
+    std::vector<float> past_;  // the last frames_ frames, [seen mod frames_][feature]
+};
+
+// A network's slopeFrames: 0, its inputs are the frame's features; n > 0, the features and then
+// each one's slope over the frame and the n before it (FeatureSlopes), twice the inputs.
+inline constexpr int kMaxSlopeFrames = 16;
+constexpr std::size_t networkInputs(std::size_t features, int slopeFrames) {
+    return slopeFrames > 0 ? 2 * features : features;
+}
+
+// What a network hears of each frame in turn, as its slopeFrames say: the frame's own features,
+// or those and their slopes. The classifier and the trainer both feed every frame through one.
+class NetworkInput {
+  public:
+    NetworkInput() = default;
+    NetworkInput(int slopeFrames, std::size_t features);
+    // The input for `frame` (its features), which becomes the newest: the frame itself without
+    // slopes, else a buffer valid until the next push. No allocation.
+    std::span<const float> push(std::span<const float> frame);
+    void reset() { slopes_.reset(); }
+
+  private:
+    FeatureSlopes slopes_;
+    std::vector<float> input_;  // empty: no slopes
+};
+
 // How far the jaw opens, heard from one frame's features (the same vector the templates are
 // matched on): a network with one hidden layer of rectified units and a logistic output, trained on
 // labelled speech against the jaw heights of the frames' phoneme classes (TemplateTrainer). A
@@ -255,15 +297,20 @@ class FrameAnalyzer {
 // pass through a class decision (Bourlard & Morgan 1994); trained on many voices it pools what
 // the frames of one jaw height share, where nearest templates follow one voice's spectrum.
 struct JawNetwork {
-    std::vector<float> inputMean, inputScale;       // per feature: x' = (x − mean) · scale
-    std::vector<std::vector<float>> hiddenWeights;  // per feature: its weight to each unit
+    std::vector<float> inputMean, inputScale;       // per input: x' = (x − mean) · scale
+    std::vector<std::vector<float>> hiddenWeights;  // per input: its weight to each unit
     std::vector<float> hiddenBias;                  // per hidden unit
     std::vector<float> outputWeights;               // per hidden unit
     float outputBias = 0;
+    int slopeFrames = 0;  // what it hears beside the frame (networkInputs)
 
     std::size_t hiddenUnits() const { return hiddenBias.size(); }
-    // The jaw height in [0, 1] (0 closed). `features`: featureCount() values.
-    float operator()(std::span<const float> features) const;
+    std::size_t inputsFor(std::size_t features) const {
+        return networkInputs(features, slopeFrames);
+    }
+    // The jaw height in [0, 1] (0 closed). `inputs`: inputsFor(featureCount()) values, a
+    // NetworkInput's of the frame.
+    float operator()(std::span<const float> inputs) const;
     // InputError naming `source` and the field when sizes disagree or a value is not finite.
     void validate(std::size_t features, const std::string& source) const;
 };
@@ -276,23 +323,18 @@ struct JawNetwork {
 // alone: FrameClassifier::templateDistances).
 struct ClassNetwork {
     std::vector<std::string> classes;               // output order: phoneme set names
-    std::vector<float> inputMean, inputScale;       // per feature: x' = (x − mean) · scale
-    std::vector<std::vector<float>> hiddenWeights;  // per feature: its weight to each unit
+    std::vector<float> inputMean, inputScale;       // per input: x' = (x − mean) · scale
+    std::vector<std::vector<float>> hiddenWeights;  // per input: its weight to each unit
     std::vector<float> hiddenBias;                  // per hidden unit
     std::vector<std::vector<float>> outputWeights;  // per hidden unit: its weight to each class
     std::vector<float> outputBias;                  // per class
     std::vector<float> logPrior;                    // per class: ln of its share of the frames
-    // 0: the inputs are the frame's features. n > 0: the features, then each one's slope over
-    // the frame and the n before it (FeatureSlopes), twice the inputs.
-    int slopeFrames = 0;
-    static constexpr int kMaxSlopeFrames = 16;
+    int slopeFrames = 0;  // what it hears beside the frame (networkInputs)
 
     std::size_t hiddenUnits() const { return hiddenBias.size(); }
-    // A network's inputs for frames of `features` features, hearing `slopeFrames` as above.
-    static std::size_t inputsFor(std::size_t features, int slopeFrames) {
-        return slopeFrames > 0 ? 2 * features : features;
+    std::size_t inputsFor(std::size_t features) const {
+        return networkInputs(features, slopeFrames);
     }
-    std::size_t inputsFor(std::size_t features) const { return inputsFor(features, slopeFrames); }
     // ln p(c | x) − priorScale · ln p(c) per class into `out` (classes.size() values), up to a
     // constant of the frame's (the softmax's normaliser, the same for every class); `scratch`:
     // at least hiddenUnits() values. No allocation. priorScale 1: the hybrid's scaled
@@ -310,25 +352,6 @@ struct ClassNetwork {
                         std::span<float> likelihoods, std::span<float> scratch) const;
     // InputError naming `source` and the field when sizes disagree or a value is not finite.
     void validate(std::size_t features, const std::string& source) const;
-};
-
-// Each feature's slope over the newest frame and the `frames` before it, by least squares: the
-// dynamic features of speech recognisers (Furui 1986), taken over past frames only, so that a
-// live frame waits for none. Frames before the first count as the first. What the class network
-// hears with ClassNetwork::slopeFrames, in training and in use alike.
-class FeatureSlopes {
-  public:
-    FeatureSlopes() = default;
-    FeatureSlopes(int frames, std::size_t features);
-    // The frame's features, then their slopes per frame, into `out` (2 · features values); the
-    // frame becomes the newest. No allocation.
-    void push(std::span<const float> frame, std::span<float> out);
-    void reset() { seen_ = 0; }
-
-  private:
-    std::size_t frames_ = 0, features_ = 0, seen_ = 0;
-    std::vector<float> weights_;  // per position 0..frames_: (j − frames_/2) / Σ (j − frames_/2)²
-    std::vector<float> past_;  // the last frames_ frames, [seen mod frames_][feature]
 };
 
 // Spectral templates: per class one or more log spectra (cluster means), on the grid of the
@@ -464,14 +487,14 @@ class FrameClassifier {
     std::vector<float> blockDistances_;  // empty unless recordBlockDistances()
     std::vector<float> jawOf_;           // per class: its jaw height (0 where the set gives none)
     std::optional<JawNetwork> jawNetwork_;
-    void addClassNetwork(const FrameFeatures& frame);
+    void addClassNetwork(std::span<const float> input);
     std::optional<ClassNetwork> classNetwork_;
     std::vector<int> networkClass_;  // per network output: its set index (-1: none)
     void addClassBias();
     std::vector<float> classBias_;  // per class, dB (TemplateSet::classBiasDb); empty: none
     std::vector<float> likelihoods_, hiddenUnits_;  // the class network's, per frame
-    FeatureSlopes slopes_;                          // with ClassNetwork::slopeFrames
-    std::vector<float> networkInput_;               // the frame and its slopes, with slopes_
+    NetworkInput classInput_, jawInput_;            // what each network hears of the frame
+    bool jawHearsClassInput_ = false;               // the same slopes: one NetworkInput for both
     std::vector<float> templateDistances_;
     int sil_ = 0;
     float noiseFloorDb_ = 0;
@@ -787,8 +810,9 @@ struct TrainingOptions {
     // 75.4 / 44.3 %; the templates alone 73.9 / 42.4 %.
     int classHiddenUnits = 32;
     int classEpochs = 4;
-    // The class network also hears each feature's slope over the frame and this many before it
-    // (ClassNetwork::slopeFrames; 0: the frame alone).
+    // Each network also hears each feature's slope over the frame and this many before it
+    // (their slopeFrames; 0: the frame alone).
+    int jawSlopeFrames = 0;
     int classSlopeFrames = 0;
 };
 
@@ -822,13 +846,18 @@ class TemplateTrainer {
     void addNetworkFrames(std::span<const FrameFeatures> frames, const PhonemeSchedule& labels,
                           float peak);
     std::optional<ClassNetwork> trainClasses(std::size_t bins) const;
+    // The networks' inputs, a row per network frame, for networks hearing `slopeFrames`.
+    const std::vector<float>& inputsWith(int slopeFrames) const;
+    template <class Network>
+    const std::vector<float>& tuningInputs(const Network& net, std::size_t features) const;
     TrainingOptions options_;
     const PhonemeSet* set_;
     std::vector<std::vector<std::vector<float>>> spectra_;  // [class][frame][bin]
-    // The networks' frames: features each, and per frame the jaw height and the class index;
-    // with classSlopeFrames, the class network's inputs apart (the features and their slopes).
-    std::vector<float> networkInputs_, jawTargets_, classInputs_;
+    // The networks' frames: per frame the jaw height and the class index, and their inputs per
+    // slopeFrames a network hears (one copy when both hear alike: NetworkInput).
+    std::vector<float> jawTargets_;
     std::vector<std::uint16_t> classTargets_;
+    std::map<int, std::vector<float>> inputs_;
     bool jawUsable_ = true;  // every labelled class has a jaw height
 };
 
