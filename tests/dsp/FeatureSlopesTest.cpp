@@ -81,6 +81,15 @@ double accuracy(const TemplateSet& t, std::mt19937& rng) {
     return test::shareDecidedRight(t, risingAndFalling(rng));
 }
 
+// `t` written to a file of that name and read back.
+TemplateSet savedAndLoaded(const TemplateSet& t, const std::string& name) {
+    const auto path = std::filesystem::temp_directory_path() / name;
+    t.save(path);
+    auto back = TemplateSet::load(path);
+    std::filesystem::remove(path);
+    return back;
+}
+
 // How much further the jaw opens for aa than for ih.
 float aaAboveIh() {
     const auto& set = PhonemeSet::common();
@@ -121,10 +130,7 @@ TEST(FeatureSlopes, TheClassNetworkHearsWhichWayTheSpectrumMoves) {
 TEST(FeatureSlopes, TravelWithTheNetworkAndAreValidated) {
     std::mt19937 rng(8);
     const auto t = train(rng, 4);
-    const auto path = std::filesystem::temp_directory_path() / "lipsyncd_feature_slopes.json";
-    t.save(path);
-    const auto back = TemplateSet::load(path);
-    std::filesystem::remove(path);
+    const auto back = savedAndLoaded(t, "lipsyncd_feature_slopes.json");
     ASSERT_TRUE(back.classNetwork.has_value());
     EXPECT_EQ(back.classNetwork->slopeFrames, 4);
     EXPECT_EQ(fineTuningOptions(back).classSlopeFrames, 4);
@@ -182,10 +188,7 @@ TEST(FeatureSlopes, TheClassifiersJawIsTheNetworksOnWhatItHears) {
 TEST(FeatureSlopes, TheJawsTravelWithItAndAreValidated) {
     std::mt19937 rng(12);
     const auto t = train(rng, 0, 4);
-    const auto path = std::filesystem::temp_directory_path() / "lipsyncd_jaw_slopes.json";
-    t.save(path);
-    const auto back = TemplateSet::load(path);
-    std::filesystem::remove(path);
+    const auto back = savedAndLoaded(t, "lipsyncd_jaw_slopes.json");
     ASSERT_TRUE(back.jawNetwork.has_value());
     EXPECT_EQ(back.jawNetwork->slopeFrames, 4);
     EXPECT_EQ(back.classNetwork->slopeFrames, 0);
