@@ -43,7 +43,9 @@ NetworkInput::NetworkInput(int slopeFrames, std::size_t features) {
 }
 
 std::span<const float> NetworkInput::push(std::span<const float> frame) {
-    if (input_.empty()) return frame;
+    // A frame of another size (not the analysis's) is passed on as it is, never read past its
+    // end; the network reads no further than its shorter input (network::hiddenSums).
+    if (input_.empty() || 2 * frame.size() != input_.size()) return frame;
     slopes_.push(frame, input_);
     return input_;
 }

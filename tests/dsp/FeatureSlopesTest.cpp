@@ -43,6 +43,17 @@ TEST(FeatureSlopes, ARampRisesByItsStepOnceItsFramesHaveCome) {
     EXPECT_NEAR(out[3], -2.0f, 1e-5);  // positions 0..3 at 100, 4 at 90: (−200 + 180) / 10
 }
 
+TEST(FeatureSlopes, ANetworkInputPassesAFrameOfAnotherSizeOnAsItIs) {
+    NetworkInput heard(2, 3);
+    const std::vector<float> frame{1, 2, 3}, short_{7, 8};
+    EXPECT_EQ(heard.push(frame).size(), 6u);  // the frame and its slopes
+    const auto passed = heard.push(short_);   // never read past its end
+    ASSERT_EQ(passed.size(), 2u);
+    EXPECT_EQ(passed.data(), short_.data());
+    const auto alone = NetworkInput(0, 3).push(frame);  // no slopes: the frame itself
+    EXPECT_EQ(alone.data(), frame.data());
+}
+
 namespace {
 // "aa" while bin 0 rises from −8 to 8 over 0.2 s, "ih" while it falls back: both classes hold the
 // same values, so neither a frame's spectrum nor the templates can tell them apart; which way
