@@ -183,11 +183,12 @@ fi
 # units or 8 passes did no better (tune jaw r the same to the hundredth; score 699.05 / 698.35
 # against 707.55, the shipped class bias beside each).
 description="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["description"].split(" + jaw network")[0])' "$out")"
-class_about="class network (64 units)"
-[ "$slopes" = 0 ] || class_about="class network (64 units, hearing the slopes over $((slopes + 1)) frames)"
-jaw_about="jaw network (32 units)"
-[ "$jaw_slopes" = 0 ] || jaw_about="jaw network (32 units, hearing the slopes over $((jaw_slopes + 1)) frames)"
-networks_about="$jaw_about and $class_about on the same speech, espeak-ng's four times"
+# "NAME network (UNITS units)", and with SLOPES above 0 what it hears beside the frame.
+network_about() {
+  if [ "$3" = 0 ]; then echo "$1 network ($2 units)"
+  else echo "$1 network ($2 units, hearing the slopes over $(($3 + 1)) frames)"; fi
+}
+networks_about="$(network_about jaw 32 "$jaw_slopes") and $(network_about class 64 "$slopes") on the same speech, espeak-ng's four times"
 [ ${#network_speakers[@]} -eq 0 ] || networks_about="$networks_about, and on ${network_speakers[*]}"
 "$lipsync" train ${seed[@]+"${seed[@]}"} "$corpus" "$corpus" "${folders[@]}" "${network_folders[@]+"${network_folders[@]}"}" \
   --keep-templates "$out" --jaw-hidden 32 --jaw-epochs 4 --class-hidden 64 --class-epochs 4 --class-slopes "$slopes" \
